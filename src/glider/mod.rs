@@ -1,0 +1,1 @@
+//! Planar 2-DOF glider mechanisms of the comparative study (Wenger, Gosselin, Chablat 2001).
