@@ -1,0 +1,276 @@
+//! Forward kinematics of the parallel module (IFToMM 2007, section VI): for (rho1, rho2, rho3),
+//! every real assembly mode (xp, yp, zp, alpha).
+//!
+//! Elimination (re-derived; the paper's intermediate systems (S2)-(S3) are not printed). With
+//! u = xp + D1 - d1, z' = zp - rho1, delta = (D2 - d2) - (D1 - d1), p2 = rho2 - rho1,
+//! p3 = rho3 - rho1 and c, s = cos, sin alpha:
+//! - (3) - (4) is eq. (14): w y + R1 s z' = 0, with w = R1 c - r1;
+//! - (6) - (5): 4 y e + 2 z' (2 R2 s + p2 - p3) = b, e = R2 c - r4,
+//!   b = L3^2 - L2^2 + (p2 + p3)(2 R2 s + p2 - p3);
+//!
+//! a linear system in (y, z') whose determinant Det = 2 R1 (p2 - p3) c + 4 (R1 r4 - r1 R2) s
+//! - 2 r1 (p2 - p3) is twice the left side of the existence condition (21). Then
+//! y = -R1 s b / Det, z' = w b / Det, and (5) - (10) gives u = U / (2 delta Det) with
+//! U = A Det + 2 b Q, A = L2^2 - K1 - delta^2 - e^2 - (R2 s + p2)^2, Q = (R1 r4 - r1 R2) s + w p2.
+//! Substituting into (10), u^2 + y^2 + z'^2 = K1 = L1^2 - R1^2 - r1^2 + 2 R1 r1 c, gives
+//!
+//!   F(alpha) = U^2 + 4 delta^2 (b^2 (R1^2 + r1^2 - 2 R1 r1 c) - K1 Det^2) = 0,
+//!
+//! a trigonometric polynomial of degree 4: with t = tan(alpha/2), (1 + t^2)^4 F is the paper's
+//! degree-8 polynomial. Its real roots are isolated in two charts (t in [-1, 1] and
+//! t' = tan((alpha - pi)/2) in [-1, 1]) so that alpha = pi is an ordinary root. Every root is
+//! back-substituted and polished by Newton on the original equations (3)-(6); where Det ~ 0
+//! (condition (21)) the point is found instead as the intersection of the four spheres at that
+//! alpha, which also yields the two solutions of a degenerate alpha.
+
+use arrayvec::ArrayVec;
+use nalgebra::{Matrix3, Vector3};
+
+use crate::branches::{Config, Verdict, config_of, module_verdict};
+use crate::machine::{Machine, ModuleGeometry};
+use crate::module_geometry::{ModulePose, Sliders, polish_pose, residual_mm};
+use crate::module_ik::wrap_angle;
+use crate::poly::roots_in;
+use crate::tolerance::{ACCEPT_RESIDUAL_MM, FK_DET_REL, SAME_SOLUTION_MM, SAME_SOLUTION_RAD};
+use crate::trig::Trig;
+
+/// Most assembly modes returned (the degree-8 polynomial, plus degenerate doubled solutions).
+pub const MAX_FK_MODES: usize = 16;
+
+/// One assembly mode.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FkMode {
+    pub pose: ModulePose,
+    pub config: Config,
+    pub verdict: Verdict,
+}
+
+impl FkMode {
+    pub fn working(&self) -> bool {
+        self.verdict.feasible()
+    }
+}
+
+pub type FkModes = ArrayVec<FkMode, MAX_FK_MODES>;
+
+/// The linear trigonometric forms of the elimination for one set of slider positions.
+struct Elimination {
+    w: Trig,
+    b: Trig,
+    det: Trig,
+    u_num: Trig,
+    delta: f64,
+}
+
+impl Elimination {
+    fn new(g: &ModuleGeometry, rho: &Sliders) -> Elimination {
+        let (r, rr, r2, r4) = (g.r_big1, g.r_small1, g.r_big2, g.r4);
+        let p2 = rho.y - rho.x;
+        let p3 = rho.z - rho.x;
+        let delta = g.dx2 - g.dx1;
+        let k0 = g.l1 * g.l1 - r * r - rr * rr;
+        let w = Trig::linear(-rr, r, 0.0);
+        let b = Trig::linear(
+            g.l3 * g.l3 - g.l2 * g.l2 + (p2 + p3) * (p2 - p3),
+            0.0,
+            2.0 * r2 * (p2 + p3),
+        );
+        let det = Trig::linear(
+            -2.0 * rr * (p2 - p3),
+            2.0 * r * (p2 - p3),
+            4.0 * (r * r4 - rr * r2),
+        );
+        let a = Trig::linear(
+            g.l2 * g.l2 - k0 - delta * delta - r2 * r2 - r4 * r4 - p2 * p2,
+            2.0 * r2 * r4 - 2.0 * r * rr,
+            -2.0 * r2 * p2,
+        );
+        let q = Trig::linear(-rr * p2, r * p2, r * r4 - rr * r2);
+        let u_num = a.mul(&det).add(&b.mul(&q).scale(2.0));
+        Elimination {
+            w,
+            b,
+            det,
+            u_num,
+            delta,
+        }
+    }
+
+    /// F(alpha) of the module documentation (degree 4).
+    fn characteristic(&self, g: &ModuleGeometry) -> Trig {
+        let (r, rr) = (g.r_big1, g.r_small1);
+        let n1 = Trig::linear(r * r + rr * rr, -2.0 * r * rr, 0.0);
+        let k1 = Trig::linear(g.l1 * g.l1 - r * r - rr * rr, 2.0 * r * rr, 0.0);
+        let b2 = self.b.mul(&self.b);
+        let det2 = self.det.mul(&self.det);
+        let inner = b2.mul(&n1).add(&k1.mul(&det2).scale(-1.0));
+        self.u_num
+            .mul(&self.u_num)
+            .add(&inner.scale(4.0 * self.delta * self.delta))
+    }
+
+    /// The pose at `alpha` from the linear solution, or None where Det ~ 0.
+    fn back_substitute(&self, g: &ModuleGeometry, rho: &Sliders, alpha: f64) -> Option<ModulePose> {
+        let det = self.det.eval(alpha);
+        let det_scale = self.det.cos[0].abs() + self.det.cos[1].abs() + self.det.sin[1].abs();
+        if det.abs() <= FK_DET_REL * det_scale || det_scale == 0.0 {
+            return None;
+        }
+        let s = alpha.sin();
+        let b = self.b.eval(alpha);
+        let y = -g.r_big1 * s * b / det;
+        let zp = self.w.eval(alpha) * b / det;
+        let u = self.u_num.eval(alpha) / (2.0 * self.delta * det);
+        Some(ModulePose {
+            p: Vector3::new(u - g.dx1, y, zp + rho.x),
+            alpha,
+        })
+    }
+}
+
+/// Points P on all four spheres of eqs. (3)-(6) at a fixed alpha: three sphere differences are
+/// planes; a unique point when they meet in one, and up to two points when they share a line
+/// (the degenerate case of condition (21)).
+fn fixed_alpha_points(g: &ModuleGeometry, rho: &Sliders, alpha: f64) -> ArrayVec<ModulePose, 2> {
+    let (s, c) = alpha.sin_cos();
+    let (r, rr, r2, r4) = (g.r_big1, g.r_small1, g.r_big2, g.r4);
+    let centers = [
+        Vector3::new(-g.dx1, rr - r * c, rho.x - r * s),
+        Vector3::new(-g.dx1, r * c - rr, rho.x + r * s),
+        Vector3::new(-g.dx2, r2 * c - r4, rho.y + r2 * s),
+        Vector3::new(-g.dx2, r4 - r2 * c, rho.z - r2 * s),
+    ];
+    let lens = [g.l1, g.l1, g.l2, g.l3];
+    let mut m = Matrix3::zeros();
+    let mut rhs = Vector3::zeros();
+    for j in 1..4 {
+        let d = centers[j] - centers[0];
+        for k in 0..3 {
+            m[(j - 1, k)] = 2.0 * d[k];
+        }
+        rhs[j - 1] = centers[j].norm_squared() - centers[0].norm_squared() - lens[j] * lens[j]
+            + lens[0] * lens[0];
+    }
+    let mut out = ArrayVec::new();
+    let svd = m.svd(true, true);
+    let (Some(u), Some(vt)) = (svd.u, svd.v_t) else {
+        return out;
+    };
+    let sv = svd.singular_values;
+    let smax = sv.max();
+    if smax == 0.0 {
+        return out;
+    }
+    // Least-squares particular solution over the well-determined directions.
+    let mut p0 = Vector3::zeros();
+    let mut null = None;
+    for k in 0..3 {
+        let v = vt.row(k).transpose();
+        if sv[k] > FK_DET_REL * smax {
+            p0 += v * (u.column(k).dot(&rhs) / sv[k]);
+        } else if null.is_none() {
+            null = Some(v);
+        } else {
+            return out; // a plane of candidates: not a finite set, nothing to report
+        }
+    }
+    match null {
+        None => out.push(ModulePose { p: p0, alpha }),
+        Some(n) => {
+            // |p0 + l n - C0|^2 = L1^2, with |n| = 1.
+            let d = p0 - centers[0];
+            let bh = n.dot(&d);
+            let cc = d.norm_squared() - lens[0] * lens[0];
+            let disc = bh * bh - cc;
+            if disc >= 0.0 {
+                let h = disc.sqrt();
+                for l in [-bh - h, -bh + h] {
+                    out.push(ModulePose {
+                        p: p0 + n * l,
+                        alpha,
+                    });
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The real roots alpha of F, from both half-angle charts.
+fn characteristic_roots(f: &Trig) -> ArrayVec<f64, 32> {
+    let mut alphas = ArrayVec::new();
+    for shift in [false, true] {
+        let mut poly = f.to_half_angle_poly(shift);
+        let scale = poly.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+        if scale == 0.0 || !scale.is_finite() {
+            return alphas;
+        }
+        for a in poly.iter_mut() {
+            *a /= scale;
+        }
+        for root in roots_in(&poly, -1.0, 1.0) {
+            let alpha = 2.0 * root.x.atan() + if shift { std::f64::consts::PI } else { 0.0 };
+            if !alphas.is_full() {
+                alphas.push(wrap_angle(alpha));
+            }
+        }
+    }
+    alphas
+}
+
+/// Every real assembly mode for the slider positions, ordered by alpha, each with its
+/// configuration and verdict. Empty when the sliders cannot be assembled.
+pub fn solve(m: &Machine, rho: &Sliders) -> FkModes {
+    let g = &m.module;
+    let mut out = FkModes::new();
+    if !rho.iter().all(|v| v.is_finite()) {
+        return out;
+    }
+    let elim = Elimination::new(g, rho);
+    let f = elim.characteristic(g);
+    for alpha in characteristic_roots(&f) {
+        let starts: ArrayVec<ModulePose, 2> = match elim.back_substitute(g, rho, alpha) {
+            Some(p) => [p].into_iter().collect(),
+            None => fixed_alpha_points(g, rho, alpha),
+        };
+        for start in starts {
+            let pose = polish_pose(g, start, rho);
+            let pose = ModulePose {
+                alpha: wrap_angle(pose.alpha),
+                ..pose
+            };
+            if residual_mm(g, &pose, rho) > ACCEPT_RESIDUAL_MM {
+                continue;
+            }
+            let dup = out.iter().any(|o| {
+                wrap_angle(o.pose.alpha - pose.alpha).abs() < SAME_SOLUTION_RAD
+                    && (o.pose.p - pose.p).amax() < SAME_SOLUTION_MM * (1.0 + pose.p.amax())
+            });
+            if dup || out.is_full() {
+                continue;
+            }
+            let config = config_of(g, &pose, rho);
+            let verdict = module_verdict(m, &pose, rho, config);
+            out.push(FkMode {
+                pose,
+                config,
+                verdict,
+            });
+        }
+    }
+    out.sort_by(|a, b| {
+        a.pose
+            .alpha
+            .total_cmp(&b.pose.alpha)
+            .then(a.config.cmp(&b.config))
+    });
+    out
+}
+
+/// The machine's assembly mode: the feasible one (the smallest |alpha| if several are).
+pub fn working(modes: &[FkMode]) -> Option<&FkMode> {
+    modes
+        .iter()
+        .filter(|b| b.working())
+        .min_by(|a, b| a.pose.alpha.abs().total_cmp(&b.pose.alpha.abs()))
+}

@@ -1,0 +1,184 @@
+//! The parallel module's constraint equations (3)-(6) of IFToMM 2007 (= AIM 2007 (3)-(6)):
+//! rod vectors, residuals and their derivatives, shared by every solver and check.
+
+use nalgebra::{Matrix4, Matrix4x3, Vector3, Vector4};
+
+use crate::machine::ModuleGeometry;
+
+/// Pose of the platform: point P (mm, base frame, z down) and its rotation alpha about x (rad).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ModulePose {
+    pub p: Vector3<f64>,
+    pub alpha: f64,
+}
+
+/// Slider positions rho1, rho2, rho3 (mm).
+pub type Sliders = Vector3<f64>;
+
+/// The four rod vectors B_ij - A_ij of eqs. (3), (4), (5), (6), in that order. Leg I has two
+/// rods (3)-(4); legs II and III are parallelograms, one vector each.
+#[inline]
+pub fn rod_vectors(g: &ModuleGeometry, pose: &ModulePose, rho: &Sliders) -> [Vector3<f64>; 4] {
+    let (s, c) = pose.alpha.sin_cos();
+    let (x, y, z) = (pose.p.x, pose.p.y, pose.p.z);
+    [
+        Vector3::new(
+            x + g.dx1,
+            y + g.r_big1 * c - g.r_small1,
+            z + g.r_big1 * s - rho.x,
+        ),
+        Vector3::new(
+            x + g.dx1,
+            y - g.r_big1 * c + g.r_small1,
+            z - g.r_big1 * s - rho.x,
+        ),
+        Vector3::new(x + g.dx2, y - g.r_big2 * c + g.r4, z - g.r_big2 * s - rho.y),
+        Vector3::new(x + g.dx2, y + g.r_big2 * c - g.r4, z + g.r_big2 * s - rho.z),
+    ]
+}
+
+/// Rod lengths in the order of [`rod_vectors`].
+#[inline]
+pub fn rod_lengths(g: &ModuleGeometry) -> [f64; 4] {
+    [g.l1, g.l1, g.l2, g.l3]
+}
+
+/// Residuals |B - A|^2 - L^2 of eqs. (3)-(6) (mm^2).
+#[inline]
+pub fn residuals(g: &ModuleGeometry, pose: &ModulePose, rho: &Sliders) -> Vector4<f64> {
+    let v = rod_vectors(g, pose, rho);
+    let l = rod_lengths(g);
+    Vector4::from_fn(|i, _| v[i].norm_squared() - l[i] * l[i])
+}
+
+/// The largest residual expressed as a length error along its rod, |f| / (2 L) (mm).
+pub fn residual_mm(g: &ModuleGeometry, pose: &ModulePose, rho: &Sliders) -> f64 {
+    let r = residuals(g, pose, rho);
+    let l = rod_lengths(g);
+    (0..4).fold(0.0f64, |m, i| m.max((r[i] / (2.0 * l[i])).abs()))
+}
+
+/// Derivatives of each rod vector with respect to alpha.
+#[inline]
+fn rod_vectors_d_alpha(g: &ModuleGeometry, alpha: f64) -> [Vector3<f64>; 4] {
+    let (s, c) = alpha.sin_cos();
+    [
+        Vector3::new(0.0, -g.r_big1 * s, g.r_big1 * c),
+        Vector3::new(0.0, g.r_big1 * s, -g.r_big1 * c),
+        Vector3::new(0.0, g.r_big2 * s, -g.r_big2 * c),
+        Vector3::new(0.0, -g.r_big2 * s, g.r_big2 * c),
+    ]
+}
+
+/// A = d(residuals)/d(xp, yp, zp, alpha): the parallel Jacobian (4x4). det A = 0 is a parallel
+/// singularity (two assembly modes meet).
+pub fn jacobian_pose(g: &ModuleGeometry, pose: &ModulePose, rho: &Sliders) -> Matrix4<f64> {
+    let v = rod_vectors(g, pose, rho);
+    let dv = rod_vectors_d_alpha(g, pose.alpha);
+    let mut a = Matrix4::zeros();
+    for i in 0..4 {
+        a[(i, 0)] = 2.0 * v[i].x;
+        a[(i, 1)] = 2.0 * v[i].y;
+        a[(i, 2)] = 2.0 * v[i].z;
+        a[(i, 3)] = 2.0 * v[i].dot(&dv[i]);
+    }
+    a
+}
+
+/// d(residuals)/d(rho1, rho2, rho3) (4x3). The serial Jacobian of the comparative study is its
+/// negative; a zero entry in a rod's row is a serial singularity (rod perpendicular to its slider).
+pub fn jacobian_sliders(g: &ModuleGeometry, pose: &ModulePose, rho: &Sliders) -> Matrix4x3<f64> {
+    let v = rod_vectors(g, pose, rho);
+    let mut b = Matrix4x3::zeros();
+    b[(0, 0)] = -2.0 * v[0].z;
+    b[(1, 0)] = -2.0 * v[1].z;
+    b[(2, 1)] = -2.0 * v[2].z;
+    b[(3, 2)] = -2.0 * v[3].z;
+    b
+}
+
+/// Angle (rad) between each rod and the downward slider axis +z: 0 for a rod hanging straight
+/// down from its slider, above 90 degrees for a rod rising from its slider.
+pub fn rod_tilts(g: &ModuleGeometry, pose: &ModulePose, rho: &Sliders) -> [f64; 4] {
+    let v = rod_vectors(g, pose, rho);
+    let l = rod_lengths(g);
+    std::array::from_fn(|i| {
+        (v[i].z / v[i].norm().max(l[i] * 1e-300))
+            .clamp(-1.0, 1.0)
+            .acos()
+    })
+}
+
+/// Newton polish on eqs. (3)-(6) for the pose, sliders fixed (forward kinematics). Returns the
+/// polished pose when it did not make the residual worse.
+pub fn polish_pose(g: &ModuleGeometry, start: ModulePose, rho: &Sliders) -> ModulePose {
+    use crate::tolerance::{NEWTON_MAX_ITER, NEWTON_STEP_STOP};
+    let mut best = start;
+    let mut best_res = residual_mm(g, &start, rho);
+    let mut cur = start;
+    for _ in 0..NEWTON_MAX_ITER {
+        let f = residuals(g, &cur, rho);
+        let a = jacobian_pose(g, &cur, rho);
+        let Some(step) = a.lu().solve(&f) else { break };
+        if !step.iter().all(|v| v.is_finite()) {
+            break;
+        }
+        cur = ModulePose {
+            p: cur.p - Vector3::new(step[0], step[1], step[2]),
+            alpha: cur.alpha - step[3],
+        };
+        let res = residual_mm(g, &cur, rho);
+        if res <= best_res {
+            best = cur;
+            best_res = res;
+        }
+        if step.amax() < NEWTON_STEP_STOP * (1.0 + cur.p.amax()) {
+            break;
+        }
+    }
+    best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::machine::Machine;
+
+    #[test]
+    fn jacobians_match_finite_differences() {
+        let g = Machine::default_verne().module;
+        let pose = ModulePose {
+            p: Vector3::new(-150.0, 80.0, 1100.0),
+            alpha: 0.13,
+        };
+        let rho = Sliders::new(400.0, 300.0, 350.0);
+        let a = jacobian_pose(&g, &pose, &rho);
+        let h = 1e-6;
+        for j in 0..4 {
+            let mut plus = pose;
+            let mut minus = pose;
+            if j < 3 {
+                plus.p[j] += h;
+                minus.p[j] -= h;
+            } else {
+                plus.alpha += h;
+                minus.alpha -= h;
+            }
+            let fd = (residuals(&g, &plus, &rho) - residuals(&g, &minus, &rho)) / (2.0 * h);
+            for i in 0..4 {
+                assert!((fd[i] - a[(i, j)]).abs() < 1e-4 * (1.0 + a[(i, j)].abs()));
+            }
+        }
+        let b = jacobian_sliders(&g, &pose, &rho);
+        for j in 0..3 {
+            let mut plus = rho;
+            let mut minus = rho;
+            plus[j] += h;
+            minus[j] -= h;
+            let fd = (residuals(&g, &pose, &plus) - residuals(&g, &pose, &minus)) / (2.0 * h);
+            for i in 0..4 {
+                assert!((fd[i] - b[(i, j)]).abs() < 1e-4 * (1.0 + b[(i, j)].abs()));
+            }
+        }
+    }
+}

@@ -1,0 +1,221 @@
+//! Real roots of small polynomials on an interval, found by a method that cannot miss a simple
+//! root: the derivative recursion (roots of p' split the interval into pieces where p is
+//! monotone; each piece with a sign change holds exactly one root, found by safeguarded Newton).
+//!
+//! Near-double roots, where p touches zero between two close roots or at a tangency, show up as
+//! critical points whose |p| is within the rounding error of evaluating p; they are reported as
+//! such so that the caller can decide on the original equations.
+
+use arrayvec::ArrayVec;
+
+/// Highest degree handled (the forward kinematics' degree-8 polynomial, IFToMM 2007 section VI).
+pub const MAX_DEGREE: usize = 8;
+
+/// Coefficients, lowest degree first.
+pub type Coeffs = ArrayVec<f64, { MAX_DEGREE + 1 }>;
+
+/// A root of p on the interval.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Root {
+    pub x: f64,
+    /// True when this is a critical point where |p| is within rounding error of 0: a double root,
+    /// or two real roots too close to separate, or a near miss (complex pair) the caller must test.
+    pub touching: bool,
+}
+
+/// Roots found on one interval (at most the degree, plus touching candidates).
+pub type Roots = ArrayVec<Root, { 2 * MAX_DEGREE }>;
+
+/// p(x) by Horner, with a running bound on its rounding error.
+#[inline]
+pub fn eval_with_error(c: &[f64], x: f64) -> (f64, f64) {
+    let mut p = 0.0;
+    let mut bound = 0.0;
+    let ax = x.abs();
+    for &a in c.iter().rev() {
+        p = p * x + a;
+        bound = bound * ax + p.abs();
+    }
+    (p, bound * 4.0 * f64::EPSILON * c.len() as f64)
+}
+
+#[inline]
+fn eval(c: &[f64], x: f64) -> f64 {
+    c.iter().rev().fold(0.0, |p, &a| p * x + a)
+}
+
+#[inline]
+fn eval_d(c: &[f64], x: f64) -> (f64, f64) {
+    let mut p = 0.0;
+    let mut d = 0.0;
+    for &a in c.iter().rev() {
+        d = d * x + p;
+        p = p * x + a;
+    }
+    (p, d)
+}
+
+fn derivative(c: &[f64]) -> Coeffs {
+    c.iter()
+        .enumerate()
+        .skip(1)
+        .map(|(i, &a)| a * i as f64)
+        .collect()
+}
+
+/// Drops leading coefficients that are negligible next to the largest one.
+fn trimmed(c: &[f64]) -> &[f64] {
+    let scale = c.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+    let mut n = c.len();
+    while n > 0 && c[n - 1].abs() <= scale * 1e-300 {
+        n -= 1;
+    }
+    &c[..n]
+}
+
+/// All real roots of the polynomial `c` (lowest degree first) in [lo, hi], sorted.
+pub fn roots_in(c: &[f64], lo: f64, hi: f64) -> Roots {
+    let mut out = Roots::new();
+    let c = trimmed(c);
+    if c.len() <= 1 {
+        return out;
+    }
+    if c.len() == 2 {
+        let x = -c[0] / c[1];
+        if x >= lo && x <= hi {
+            out.push(Root { x, touching: false });
+        }
+        return out;
+    }
+    let d = derivative(c);
+    let crit = roots_in(&d, lo, hi);
+    let mut a = lo;
+    let (mut fa, mut ea) = eval_with_error(c, a);
+    if fa.abs() <= ea {
+        out.push(Root {
+            x: a,
+            touching: false,
+        });
+    }
+    for k in 0..=crit.len() {
+        let b = if k < crit.len() { crit[k].x } else { hi };
+        let (fb, eb) = eval_with_error(c, b);
+        let a_zero = fa.abs() <= ea;
+        let b_zero = fb.abs() <= eb;
+        if !a_zero && !b_zero && (fa < 0.0) != (fb < 0.0) {
+            push_unique(&mut out, bracketed(c, a, b, fa));
+        } else if b_zero {
+            // b is a root (an end point, or a critical point touching zero).
+            let touching = k < crit.len();
+            push_unique(&mut out, Root { x: b, touching });
+        }
+        a = b;
+        fa = fb;
+        ea = eb;
+    }
+    out
+}
+
+fn push_unique(out: &mut Roots, r: Root) {
+    if let Some(last) = out.last_mut()
+        && (r.x - last.x).abs() <= 4.0 * f64::EPSILON * (1.0 + r.x.abs())
+    {
+        last.touching &= r.touching;
+        return;
+    }
+    if !out.is_full() {
+        out.push(r);
+    }
+}
+
+/// The single root of a polynomial that is monotone on [a, b] with a sign change there:
+/// Newton steps kept inside a shrinking bracket, bisection when a step leaves it.
+fn bracketed(c: &[f64], mut a: f64, mut b: f64, fa: f64) -> Root {
+    let a_neg = fa < 0.0;
+    let mut x = 0.5 * (a + b);
+    for _ in 0..200 {
+        let (f, df) = eval_d(c, x);
+        if f == 0.0 {
+            break;
+        }
+        if (f < 0.0) == a_neg {
+            a = x;
+        } else {
+            b = x;
+        }
+        let newton = x - f / df;
+        let next = if df != 0.0 && newton > a && newton < b {
+            newton
+        } else {
+            0.5 * (a + b)
+        };
+        if (next - x).abs() <= 2.0 * f64::EPSILON * x.abs().max(1e-300)
+            || b - a <= f64::EPSILON * (a.abs() + b.abs())
+        {
+            x = next;
+            break;
+        }
+        x = next;
+    }
+    let _ = eval(c, x);
+    Root { x, touching: false }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn from_roots(rs: &[f64]) -> Vec<f64> {
+        let mut c = vec![1.0];
+        for &r in rs {
+            let mut n = vec![0.0; c.len() + 1];
+            for (i, &a) in c.iter().enumerate() {
+                n[i + 1] += a;
+                n[i] -= r * a;
+            }
+            c = n;
+        }
+        c
+    }
+
+    #[test]
+    fn finds_every_root_of_a_degree_eight() {
+        let rs = [-0.9, -0.5, -0.11390, -0.07054, 0.2, 0.5, 0.8, 0.95];
+        let c = from_roots(&rs);
+        let got = roots_in(&c, -1.0, 1.0);
+        assert_eq!(got.len(), 8, "{got:?}");
+        for (g, r) in got.iter().zip(rs) {
+            assert!((g.x - r).abs() < 1e-12, "{} vs {}", g.x, r);
+        }
+    }
+
+    #[test]
+    fn close_pair_is_separated() {
+        let rs = [0.1, 0.1 + 6.7e-5, 0.5];
+        let c = from_roots(&rs);
+        let got = roots_in(&c, -1.0, 1.0);
+        assert_eq!(got.len(), 3, "{got:?}");
+    }
+
+    #[test]
+    fn double_root_is_reported_touching() {
+        let c = from_roots(&[0.3, 0.3, -0.7]);
+        let got = roots_in(&c, -1.0, 1.0);
+        assert!(
+            got.iter().any(|r| (r.x - 0.3).abs() < 1e-7 && r.touching),
+            "{got:?}"
+        );
+        assert!(
+            got.iter().any(|r| (r.x + 0.7).abs() < 1e-12 && !r.touching),
+            "{got:?}"
+        );
+    }
+
+    #[test]
+    fn roots_outside_are_ignored_and_endpoints_kept() {
+        let c = from_roots(&[-1.0, 2.0, 0.25]);
+        let got = roots_in(&c, -1.0, 1.0);
+        assert_eq!(got.len(), 2, "{got:?}");
+        assert_eq!(got[0].x, -1.0);
+    }
+}
