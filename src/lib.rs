@@ -2,12 +2,18 @@
 //!
 //! The library computes; the binary (`src/main.rs`) talks. Nothing here prints or exits.
 
+pub mod apt;
 pub mod branches;
+pub mod error;
 pub mod glider;
 pub mod machine;
+pub mod machine_kin;
 pub mod module_fk;
 pub mod module_geometry;
 pub mod module_ik;
+pub mod orientation;
+pub mod pipeline;
 pub mod poly;
+pub mod table;
 pub mod tolerance;
 pub mod trig;

@@ -1,1 +1,38 @@
-fn main() {}
+//! The `verne` binary: parses arguments, runs one subcommand, prints one error, picks the exit
+//! code (0 ok, 1 some row or check failed, 2 fatal).
+
+mod cli;
+mod cmd;
+
+use std::process::ExitCode;
+
+use clap::Parser;
+
+fn main() -> ExitCode {
+    let cli = match cli::Cli::try_parse() {
+        Ok(c) => c,
+        Err(e) => {
+            let _ = e.print();
+            return ExitCode::from(if e.use_stderr() {
+                cmd::EXIT_FATAL
+            } else {
+                cmd::EXIT_OK
+            });
+        }
+    };
+    let result = match &cli.command {
+        cli::Command::Ik(a) => cmd::ik::run(a),
+        cli::Command::Fk(a) => cmd::fk::run(a),
+        cli::Command::Modes(a) => cmd::modes::run(a),
+        cli::Command::Machine(c) => cmd::machine::run(c),
+    };
+    match result {
+        Ok(code) => ExitCode::from(code),
+        Err(e) if e.is_broken_pipe() => ExitCode::from(cmd::EXIT_OK),
+        Err(e) => {
+            verne::table::remove_temp_files();
+            eprintln!("verne: error: {e}");
+            ExitCode::from(cmd::EXIT_FATAL)
+        }
+    }
+}

@@ -8,8 +8,9 @@
 //! - (6) - (5): 4 y e + 2 z' (2 R2 s + p2 - p3) = b, e = R2 c - r4,
 //!   b = L3^2 - L2^2 + (p2 + p3)(2 R2 s + p2 - p3);
 //!
-//! a linear system in (y, z') whose determinant Det = 2 R1 (p2 - p3) c + 4 (R1 r4 - r1 R2) s
-//! - 2 r1 (p2 - p3) is twice the left side of the existence condition (21). Then
+//! a linear system in (y, z') whose determinant
+//! Det = 2 (p2 - p3)(R1 c - r1) + 4 (R1 r4 - r1 R2) s is twice the left side of the existence
+//! condition (21). Then
 //! y = -R1 s b / Det, z' = w b / Det, and (5) - (10) gives u = U / (2 delta Det) with
 //! U = A Det + 2 b Q, A = L2^2 - K1 - delta^2 - e^2 - (R2 s + p2)^2, Q = (R1 r4 - r1 R2) s + w p2.
 //! Substituting into (10), u^2 + y^2 + z'^2 = K1 = L1^2 - R1^2 - r1^2 + 2 R1 r1 c, gives

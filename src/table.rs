@@ -1,0 +1,378 @@
+//! CSV tables: the only place that builds csv readers and writers. Reading checks headers once
+//! and parses numbers with file/line/column errors; writing goes to stdout or to a temporary file
+//! beside the target that is renamed into place only when the run succeeds.
+
+use std::fs::File;
+use std::io::{self, BufWriter, Read, Write};
+use std::path::{Path, PathBuf};
+
+use csv::ByteRecord;
+
+use crate::error::VerneError;
+
+/// A CSV input with a header row (file or stdin).
+pub struct CsvSource {
+    reader: csv::Reader<Box<dyn Read + Send>>,
+    name: String,
+    headers: ByteRecord,
+}
+
+impl CsvSource {
+    /// Opens `path`; `None` or `-` reads standard input.
+    pub fn open(path: Option<&Path>) -> Result<CsvSource, VerneError> {
+        match path {
+            None => Self::from_reader(Box::new(io::stdin()), "<stdin>"),
+            Some(p) if p.as_os_str() == "-" => Self::from_reader(Box::new(io::stdin()), "<stdin>"),
+            Some(p) => {
+                let name = p.display().to_string();
+                let f = File::open(p).map_err(|e| VerneError::io(&name, e))?;
+                Self::from_reader(Box::new(io::BufReader::with_capacity(1 << 16, f)), &name)
+            }
+        }
+    }
+
+    /// Reads CSV text from any reader; `name` is used in error messages.
+    pub fn from_reader(r: Box<dyn Read + Send>, name: &str) -> Result<CsvSource, VerneError> {
+        let mut reader = csv::ReaderBuilder::new()
+            .has_headers(true)
+            .trim(csv::Trim::All)
+            .comment(None)
+            .buffer_capacity(1 << 16)
+            .from_reader(r);
+        let headers = match reader.byte_headers() {
+            Ok(h) => h.clone(),
+            Err(e) => return Err(csv_error(name, e)),
+        };
+        if headers.is_empty() || (headers.len() == 1 && headers[0].is_empty()) {
+            return Err(VerneError::input(
+                name,
+                Some(1),
+                None,
+                "empty input: expected a CSV header line",
+            ));
+        }
+        let mut headers_clean = ByteRecord::new();
+        for (i, h) in headers.iter().enumerate() {
+            // A UTF-8 byte-order mark before the first name is accepted and dropped.
+            let h = if i == 0 {
+                h.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(h)
+            } else {
+                h
+            };
+            headers_clean.push_field(h);
+        }
+        let src = CsvSource {
+            reader,
+            name: name.to_string(),
+            headers: headers_clean,
+        };
+        src.check_duplicate_headers()?;
+        Ok(src)
+    }
+
+    fn check_duplicate_headers(&self) -> Result<(), VerneError> {
+        for (i, h) in self.headers.iter().enumerate() {
+            if self.headers.iter().take(i).any(|o| o == h) {
+                return Err(VerneError::input(
+                    &self.name,
+                    Some(1),
+                    Some(&String::from_utf8_lossy(h)),
+                    format!(
+                        "column `{}` appears twice in the header; expected unique column names",
+                        String::from_utf8_lossy(h)
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    pub fn headers(&self) -> &ByteRecord {
+        &self.headers
+    }
+
+    /// Index of a column by exact name.
+    pub fn column(&self, name: &str) -> Option<usize> {
+        self.headers.iter().position(|h| h == name.as_bytes())
+    }
+
+    /// Indices of the required columns, or an error naming the missing ones and the header found.
+    pub fn require(&self, names: &[&str]) -> Result<Vec<usize>, VerneError> {
+        let missing: Vec<&str> = names
+            .iter()
+            .copied()
+            .filter(|n| self.column(n).is_none())
+            .collect();
+        if missing.is_empty() {
+            return Ok(names.iter().map(|n| self.column(n).unwrap_or(0)).collect());
+        }
+        Err(VerneError::input(
+            &self.name,
+            Some(1),
+            None,
+            format!(
+                "missing column{} {}; expected a header with {}, found `{}`",
+                if missing.len() > 1 { "s" } else { "" },
+                missing
+                    .iter()
+                    .map(|m| format!("`{m}`"))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                names.join(","),
+                self.header_text()
+            ),
+        ))
+    }
+
+    pub fn header_text(&self) -> String {
+        self.headers
+            .iter()
+            .map(|h| String::from_utf8_lossy(h).into_owned())
+            .collect::<Vec<_>>()
+            .join(",")
+    }
+
+    /// Reads the next record into `rec`; false at the end of the input.
+    pub fn read(&mut self, rec: &mut ByteRecord) -> Result<bool, VerneError> {
+        match self.reader.read_byte_record(rec) {
+            Ok(more) => Ok(more),
+            Err(e) => Err(csv_error(&self.name, e)),
+        }
+    }
+}
+
+fn csv_error(name: &str, e: csv::Error) -> VerneError {
+    let line = e.position().map(|p| p.line());
+    match e.into_kind() {
+        csv::ErrorKind::UnequalLengths {
+            expected_len, len, ..
+        } => VerneError::input(
+            name,
+            line,
+            None,
+            format!("row has {len} fields; expected {expected_len} like the header"),
+        ),
+        csv::ErrorKind::Io(io) => VerneError::io(name, io),
+        other => VerneError::input(name, line, None, format!("malformed CSV: {other:?}")),
+    }
+}
+
+/// A number cell could not be read.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CellError {
+    /// Not a number at all (text, units, decimal comma): the file is malformed.
+    NotANumber,
+    /// Empty, NaN or infinite: the row is invalid, the run goes on.
+    NotFinite,
+}
+
+/// Parses a numeric cell (surrounding spaces already trimmed by the reader).
+#[inline]
+pub fn parse_number(field: &[u8]) -> Result<f64, CellError> {
+    if field.is_empty() {
+        return Err(CellError::NotFinite);
+    }
+    let s = std::str::from_utf8(field).map_err(|_| CellError::NotANumber)?;
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(_) => Err(CellError::NotFinite),
+        Err(_) => Err(CellError::NotANumber),
+    }
+}
+
+/// Where output goes: stdout, or a file written atomically.
+pub struct Sink {
+    writer: csv::Writer<Box<dyn Write + Send>>,
+    target: Option<(PathBuf, PathBuf)>,
+    name: String,
+}
+
+impl Sink {
+    /// `None` or `-` is stdout; a path is written through a temporary file in the same directory.
+    pub fn create(path: Option<&Path>) -> Result<Sink, VerneError> {
+        let (inner, target, name): (Box<dyn Write + Send>, _, String) = match path {
+            Some(p) if p.as_os_str() != "-" => {
+                let name = p.display().to_string();
+                let tmp = temp_path_for(p);
+                let f = File::create(&tmp).map_err(|e| VerneError::io(&name, e))?;
+                (
+                    Box::new(BufWriter::with_capacity(1 << 16, f)),
+                    Some((tmp, p.to_path_buf())),
+                    name,
+                )
+            }
+            _ => (
+                Box::new(BufWriter::with_capacity(1 << 16, io::stdout())),
+                None,
+                "<stdout>".to_string(),
+            ),
+        };
+        if let Some((tmp, _)) = &target {
+            crate::table::register_temp(tmp);
+        }
+        Ok(Sink {
+            writer: csv::WriterBuilder::new().from_writer(inner),
+            target,
+            name,
+        })
+    }
+
+    pub fn write(&mut self, rec: &ByteRecord) -> Result<(), VerneError> {
+        self.writer
+            .write_byte_record(rec)
+            .map_err(|e| self.io_error(e))
+    }
+
+    fn io_error(&self, e: csv::Error) -> VerneError {
+        match e.into_kind() {
+            csv::ErrorKind::Io(io) => VerneError::io(&self.name, io),
+            other => VerneError::io(&self.name, io::Error::other(format!("{other:?}"))),
+        }
+    }
+
+    /// Flushes and, for a file, renames the temporary file into place.
+    pub fn finish(mut self) -> Result<(), VerneError> {
+        let flushed = self
+            .writer
+            .flush()
+            .map_err(|e| VerneError::io(&self.name, e));
+        if let Err(e) = flushed {
+            self.discard();
+            return Err(e);
+        }
+        if let Some((tmp, dest)) = self.target.take() {
+            // Drop the writer (closing the file) before renaming.
+            let writer = std::mem::replace(
+                &mut self.writer,
+                csv::Writer::from_writer(Box::new(io::sink())),
+            );
+            match writer.into_inner() {
+                Ok(mut inner) => {
+                    if let Err(e) = inner.flush() {
+                        let _ = std::fs::remove_file(&tmp);
+                        unregister_temp(&tmp);
+                        return Err(VerneError::io(&self.name, e));
+                    }
+                }
+                Err(e) => {
+                    let _ = std::fs::remove_file(&tmp);
+                    unregister_temp(&tmp);
+                    return Err(VerneError::io(&self.name, e.into_error()));
+                }
+            }
+            let renamed = std::fs::rename(&tmp, &dest);
+            unregister_temp(&tmp);
+            if let Err(e) = renamed {
+                let _ = std::fs::remove_file(&tmp);
+                return Err(VerneError::io(&self.name, e));
+            }
+        }
+        Ok(())
+    }
+
+    /// Abandons the output: the temporary file is removed, the target is left untouched.
+    pub fn discard(&mut self) {
+        if let Some((tmp, _)) = self.target.take() {
+            let _ = std::fs::remove_file(&tmp);
+            unregister_temp(&tmp);
+        }
+    }
+}
+
+impl Drop for Sink {
+    fn drop(&mut self) {
+        self.discard();
+    }
+}
+
+/// `dir/.name.verne-PID.tmp` beside the target.
+fn temp_path_for(p: &Path) -> PathBuf {
+    let file = p
+        .file_name()
+        .map(|f| f.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "out".into());
+    let tmp = format!(".{file}.verne-{}.tmp", std::process::id());
+    match p.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.join(tmp),
+        _ => PathBuf::from(tmp),
+    }
+}
+
+static TEMP_FILES: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+fn register_temp(p: &Path) {
+    if let Ok(mut v) = TEMP_FILES.lock() {
+        v.push(p.to_path_buf());
+    }
+}
+
+fn unregister_temp(p: &Path) {
+    if let Ok(mut v) = TEMP_FILES.lock() {
+        v.retain(|q| q != p);
+    }
+}
+
+/// Removes every temporary output file still open (for a signal handler or a fatal exit).
+pub fn remove_temp_files() {
+    if let Ok(v) = TEMP_FILES.lock() {
+        for p in v.iter() {
+            let _ = std::fs::remove_file(p);
+        }
+    }
+}
+
+/// Appends a number to `out`: shortest round-trip form, or a fixed number of decimals.
+#[inline]
+pub fn format_number(out: &mut Vec<u8>, v: f64, decimals: Option<usize>) {
+    let v = if v == 0.0 { 0.0 } else { v }; // no "-0"
+    match decimals {
+        None => {
+            let mut buf = ryu::Buffer::new();
+            let s = buf.format(v);
+            let s = s.strip_suffix(".0").unwrap_or(s);
+            out.extend_from_slice(s.as_bytes());
+        }
+        Some(d) => {
+            let _ = write!(out, "{v:.d$}");
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_parse_and_classify() {
+        assert_eq!(parse_number(b"1.5"), Ok(1.5));
+        assert_eq!(parse_number(b"-2e3"), Ok(-2000.0));
+        assert_eq!(parse_number(b"NaN"), Err(CellError::NotFinite));
+        assert_eq!(parse_number(b"inf"), Err(CellError::NotFinite));
+        assert_eq!(parse_number(b""), Err(CellError::NotFinite));
+        assert_eq!(parse_number(b"1,5"), Err(CellError::NotANumber));
+        assert_eq!(parse_number(b"12mm"), Err(CellError::NotANumber));
+        assert_eq!(parse_number(b"\xff"), Err(CellError::NotANumber));
+    }
+
+    #[test]
+    fn numbers_format_round_trip() {
+        for v in [0.1, -0.0, 368.354796, 1e-7, 123456.0, -2.5e-12] {
+            let mut out = Vec::new();
+            format_number(&mut out, v, None);
+            let s = String::from_utf8(out).unwrap();
+            assert_eq!(
+                s.parse::<f64>().unwrap(),
+                if v == 0.0 { 0.0 } else { v },
+                "{s}"
+            );
+            assert!(!s.starts_with("-0") || v != 0.0);
+        }
+        let mut out = Vec::new();
+        format_number(&mut out, 2.0, None);
+        assert_eq!(out, b"2");
+    }
+}
