@@ -17,3 +17,4 @@ pub mod poly;
 pub mod table;
 pub mod tolerance;
 pub mod trig;
+pub mod jacobian;
