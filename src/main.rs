@@ -8,7 +8,15 @@ use std::process::ExitCode;
 
 use clap::Parser;
 
+/// Exit code after Ctrl-C or SIGTERM (128 + SIGINT), once temporary output files are removed.
+const EXIT_INTERRUPTED: i32 = 130;
+
 fn main() -> ExitCode {
+    // An interrupted run leaves neither a partial output file nor a temporary file behind.
+    let _ = ctrlc::set_handler(|| {
+        verne::table::remove_temp_files();
+        std::process::exit(EXIT_INTERRUPTED);
+    });
     let cli = match cli::Cli::try_parse() {
         Ok(c) => c,
         Err(e) => {

@@ -12,6 +12,9 @@ use super::{inline_source, load_machine, run_rows, units};
 use crate::cli::FkArgs;
 
 pub fn run(args: &FkArgs) -> Result<u8, VerneError> {
+    if let Some(spec) = super::glider::load(args.common.machine.as_deref())? {
+        return super::glider::fk(args, spec);
+    }
     let machine = load_machine(args.common.machine.as_deref())?;
     let source = if args.joints.is_empty() {
         CsvSource::open(args.input.as_deref())?

@@ -11,6 +11,9 @@ use crate::cli::IkArgs;
 use verne::table::CsvSource;
 
 pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
+    if let Some(spec) = super::glider::load(args.common.machine.as_deref())? {
+        return super::glider::ik(args, spec);
+    }
     let machine = load_machine(args.common.machine.as_deref())?;
     let source = if args.pose.is_empty() {
         CsvSource::open(args.input.as_deref())?

@@ -2,6 +2,7 @@
 //! input and output, and turning a run's summary into an exit code.
 
 pub mod fk;
+pub mod glider;
 pub mod ik;
 pub mod machine;
 pub mod modes;
@@ -26,6 +27,7 @@ pub const EXIT_FATAL: u8 = 2;
 pub fn load_machine(path: Option<&Path>) -> Result<Machine, VerneError> {
     match path {
         None => Ok(Machine::default_verne()),
+        Some(p) if !p.exists() && p.as_os_str() == "verne" => Ok(Machine::default_verne()),
         Some(p) => {
             let name = p.display().to_string();
             let text = std::fs::read(p).map_err(|e| VerneError::io(&name, e))?;

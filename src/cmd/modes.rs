@@ -10,6 +10,9 @@ use super::{EXIT_OK, EXIT_ROWS_FAILED, load_machine, units, write_stdout};
 use crate::cli::ModesArgs;
 
 pub fn run(args: &ModesArgs) -> Result<u8, VerneError> {
+    if let Some(spec) = super::glider::load(args.common.machine.as_deref())? {
+        return super::glider::modes(args, spec);
+    }
     let machine = load_machine(args.common.machine.as_deref())?;
     let u = units(&args.common);
     let angle = if u.radians { "alpha_rad" } else { "alpha_deg" };
