@@ -39,6 +39,22 @@ pub enum Command {
     /// Show the default machine file, or check one.
     #[command(subcommand)]
     Machine(MachineCommand),
+    /// Round-trip self-test of a machine file over a grid of joints: reports the worst residual.
+    #[command(
+        after_help = "Example:\n  verne selftest -m my_machine.toml --grid 16\n\nExit codes: 0 every round trip returned, 1 some did not, 2 fatal."
+    )]
+    Selftest(SelftestArgs),
+    /// Print a shell completion script.
+    #[command(
+        after_help = "Example:\n  verne completions bash > ~/.local/share/bash-completion/completions/verne"
+    )]
+    Completions {
+        /// The shell.
+        shell: clap_complete::Shell,
+    },
+    /// Print the man page (roff), as kept in docs/verne.1.
+    #[command(hide = true)]
+    Manpage,
 }
 
 /// Options shared by the row commands.
@@ -137,6 +153,16 @@ pub fn parse_triple(s: &str) -> Result<[f64; 3], String> {
         }
     }
     Ok(out)
+}
+
+#[derive(Debug, Args)]
+pub struct SelftestArgs {
+    /// Machine file (default: the embedded VERNE machine).
+    #[arg(short = 'm', long = "machine", value_name = "FILE")]
+    pub machine: Option<PathBuf>,
+    /// Grid points per slider axis (the grid spans the strokes: N^3 joint sets).
+    #[arg(long, value_name = "N", default_value_t = 12, value_parser = clap::value_parser!(u16).range(2..=200))]
+    pub grid: u16,
 }
 
 #[cfg(test)]

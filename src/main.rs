@@ -33,6 +33,9 @@ fn main() -> ExitCode {
         cli::Command::Fk(a) => cmd::fk::run(a),
         cli::Command::Modes(a) => cmd::modes::run(a),
         cli::Command::Machine(c) => cmd::machine::run(c),
+        cli::Command::Selftest(a) => cmd::selftest::run(a),
+        cli::Command::Completions { shell } => cmd::shell::completions(*shell),
+        cli::Command::Manpage => cmd::shell::manpage(),
     };
     match result {
         Ok(code) => ExitCode::from(code),

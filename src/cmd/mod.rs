@@ -6,6 +6,8 @@ pub mod glider;
 pub mod ik;
 pub mod machine;
 pub mod modes;
+pub mod selftest;
+pub mod shell;
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
