@@ -273,7 +273,10 @@ impl Machine {
                     problems: vec![Problem {
                         line,
                         key: String::new(),
-                        message: format!("not valid TOML: {}", e.message()),
+                        message: format!(
+                            "not valid TOML: {}",
+                            e.message().trim().replace('\n', "; ")
+                        ),
                     }],
                 });
             }
@@ -373,6 +376,18 @@ impl Machine {
                     (m.r_big1 - m.r_small1).abs()
                 ),
             );
+        }
+        let gap = m.r4 - m.r_big2;
+        for (key, l) in [("module.L2", m.l2), ("module.L3", m.l3)] {
+            if l <= gap {
+                push(
+                    key,
+                    format!(
+                        "{} = {l} mm is too short to reach: the slider and platform joints are at least r4 - R2 = {gap} mm apart, so the machine has no workspace",
+                        &key[7..]
+                    ),
+                );
+            }
         }
         if m.r_big1 <= m.r_small1 {
             push(
@@ -626,6 +641,7 @@ fn finish(
             });
         }
     }
+    problems.sort_by_key(|p| p.line.unwrap_or(usize::MAX));
     if !problems.is_empty() {
         return Err(MachineError {
             source: source.to_string(),

@@ -10,7 +10,7 @@ use rayon::prelude::*;
 
 use crate::branches::Verdict;
 use crate::error::VerneError;
-use crate::table::{CellError, CsvSource, Sink, format_number, parse_number};
+use crate::table::{CellError, CsvSource, Sink, format_number, parse_number, shown};
 
 /// Rows solved together; bounds memory and amortises thread hand-off.
 pub const BATCH_ROWS: usize = 4096;
@@ -261,7 +261,7 @@ pub fn run<J: RowJob>(
                                 } else {
                                     " (mm)"
                                 },
-                                String::from_utf8_lossy(field)
+                                shown(field)
                             ),
                         ));
                     }

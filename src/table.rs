@@ -76,10 +76,10 @@ impl CsvSource {
                 return Err(VerneError::input(
                     &self.name,
                     Some(1),
-                    Some(&String::from_utf8_lossy(h)),
+                    Some(&shown(h)),
                     format!(
                         "column `{}` appears twice in the header; expected unique column names",
-                        String::from_utf8_lossy(h)
+                        shown(h)
                     ),
                 ));
             }
@@ -115,7 +115,7 @@ impl CsvSource {
             Some(1),
             None,
             format!(
-                "missing column{} {}; expected a header with {}, found `{}`",
+                "missing column{} {}; expected a header with {}, found `{}`{}",
                 if missing.len() > 1 { "s" } else { "" },
                 missing
                     .iter()
@@ -123,17 +123,20 @@ impl CsvSource {
                     .collect::<Vec<_>>()
                     .join(", "),
                 names.join(","),
-                self.header_text()
+                self.header_text(),
+                if self.headers.len() == 1 && self.header_text().contains(';') {
+                    " (the file looks separated by `;`; verne reads comma-separated values)"
+                } else {
+                    ""
+                }
             ),
         ))
     }
 
+    /// The header as text for a message, shortened to [`MESSAGE_CHARS`].
     pub fn header_text(&self) -> String {
-        self.headers
-            .iter()
-            .map(|h| String::from_utf8_lossy(h).into_owned())
-            .collect::<Vec<_>>()
-            .join(",")
+        let joined: Vec<u8> = self.headers.iter().collect::<Vec<_>>().join(&b","[..]);
+        shown(&joined)
     }
 
     /// Reads the next record into `rec`; false at the end of the input.
@@ -142,6 +145,23 @@ impl CsvSource {
             Ok(more) => Ok(more),
             Err(e) => Err(csv_error(&self.name, e)),
         }
+    }
+}
+
+/// Longest piece of input quoted in a message (characters).
+pub const MESSAGE_CHARS: usize = 120;
+
+/// Input bytes as they may be quoted in a message: invalid UTF-8 escaped, long text shortened.
+pub fn shown(bytes: &[u8]) -> String {
+    let text = match std::str::from_utf8(bytes) {
+        Ok(t) => t.to_string(),
+        Err(_) => bytes.escape_ascii().to_string(),
+    };
+    if text.chars().count() > MESSAGE_CHARS {
+        let head: String = text.chars().take(MESSAGE_CHARS).collect();
+        format!("{head}... ({} bytes)", bytes.len())
+    } else {
+        text
     }
 }
 
@@ -154,7 +174,10 @@ fn csv_error(name: &str, e: csv::Error) -> VerneError {
             name,
             line,
             None,
-            format!("row has {len} fields; expected {expected_len} like the header"),
+            format!(
+                "row has {len} field{}; expected {expected_len} like the header (an unterminated quote also reads to the end of the file)",
+                if len == 1 { "" } else { "s" }
+            ),
         ),
         csv::ErrorKind::Io(io) => VerneError::io(name, io),
         other => VerneError::input(name, line, None, format!("malformed CSV: {other:?}")),
