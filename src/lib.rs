@@ -21,3 +21,4 @@ pub mod table;
 pub mod tolerance;
 pub mod trig;
 pub mod workspace;
+pub mod module_rows;
