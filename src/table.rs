@@ -244,6 +244,15 @@ impl Sink {
         })
     }
 
+    /// A sink over any writer (tests, fuzzing, in-memory output).
+    pub fn from_writer(w: Box<dyn Write + Send>, name: &str) -> Sink {
+        Sink {
+            writer: csv::WriterBuilder::new().from_writer(w),
+            target: None,
+            name: name.to_string(),
+        }
+    }
+
     pub fn write(&mut self, rec: &ByteRecord) -> Result<(), VerneError> {
         self.writer
             .write_byte_record(rec)

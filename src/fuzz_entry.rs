@@ -1,0 +1,45 @@
+//! Entry points shared by the fuzz targets (fuzz/fuzz_targets) and the corpus replay test
+//! (tests/fuzz_corpus.rs): each feeds arbitrary bytes to one reader of user input and must
+//! return (an answer or an error), never panic or hang.
+
+use std::io::Cursor;
+
+use crate::machine::Machine;
+use crate::module_rows::{ModuleFk, ModuleIk};
+use crate::pipeline::{self, Units};
+use crate::table::{CsvSource, Sink};
+
+/// CSV rows through the module inverse (`fk == false`) or forward kinematics, every branch.
+pub fn csv_rows(data: &[u8], fk: bool) {
+    let Ok(mut source) = CsvSource::from_reader(Box::new(Cursor::new(data.to_vec())), "fuzz") else {
+        return;
+    };
+    let mut sink = Sink::from_writer(Box::new(std::io::sink()), "sink");
+    let machine = Machine::default_verne();
+    let units = Units::default();
+    let _ = if fk {
+        pipeline::run(&mut ModuleFk { machine, all: true }, &mut source, &mut sink, units, &|_| {})
+    } else {
+        pipeline::run(&mut ModuleIk { machine, all: true }, &mut source, &mut sink, units, &|_| {})
+    };
+}
+
+/// A machine file, TOML or key,value CSV.
+pub fn machine_file(data: &[u8]) {
+    if let Ok(text) = std::str::from_utf8(data) {
+        let _ = Machine::from_str_auto(text, "fuzz");
+    }
+}
+
+/// An APT CL file, read to the end or to its first error.
+pub fn apt_file(data: &[u8]) {
+    let mut reader = crate::apt::AptReader::new(Cursor::new(data));
+    while let Ok(Some(_)) = reader.next_row() {}
+}
+
+/// The command-line value parsers, on any text.
+pub fn arg_values(data: &[u8]) {
+    if let Ok(text) = std::str::from_utf8(data) {
+        let _ = crate::arg_values::parse_triple(text);
+    }
+}
