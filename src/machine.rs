@@ -52,6 +52,9 @@ pub struct Machine {
     pub table: TableGeometry,
     /// Tool length Delta (mm), AIM 2007 eq. (8).
     pub tool_length: f64,
+    /// The optional `[verify]` table: thresholds of `verne verify` by name, as written (the
+    /// verify module checks the names and values).
+    pub verify: Vec<(String, f64, Option<usize>)>,
 }
 
 /// One problem found in a machine file.
@@ -481,7 +484,7 @@ fn toml_value(v: &toml::Value) -> Value {
 /// Sections that are not tables, or unknown sections, are reported once.
 fn check_sections(table: &toml::Table, text: &str) -> Vec<Problem> {
     let mut out = Vec::new();
-    for section in ["module", "limits", "table", "tool"] {
+    for section in ["module", "limits", "table", "tool", "verify"] {
         if let Some(v) = table.get(section)
             && !v.is_table()
         {
@@ -522,6 +525,7 @@ fn finish(
     let line_of = |key: &str| entries.iter().find(|e| e.key == key).and_then(|e| e.line);
     let mut values = [f64::NAN; SCHEMA.len()];
     let mut kind_seen = false;
+    let mut verify = Vec::new();
     let mut name = String::from("unnamed");
     // Unknown and duplicated keys.
     for (idx, e) in entries.iter().enumerate() {
@@ -547,6 +551,17 @@ fn finish(
                     line: e.line,
                     key: e.key.clone(),
                     message: "expected \"verne\"".into(),
+                }),
+            }
+            continue;
+        }
+        if let Some(name) = e.key.strip_prefix("verify.") {
+            match &e.value {
+                Value::Number(x) if x.is_finite() => verify.push((name.to_string(), *x, e.line)),
+                _ => problems.push(Problem {
+                    line: e.line,
+                    key: e.key.clone(),
+                    message: "expected a finite number (a verify threshold)".into(),
                 }),
             }
             continue;
@@ -674,6 +689,7 @@ fn finish(
             d_t: v(21),
         },
         tool_length: v(22),
+        verify,
     };
     let cross = machine.cross_checks(&line_of);
     if cross.is_empty() {
