@@ -36,9 +36,20 @@ pub enum Command {
         after_help = "Example:\n  verne modes --joints 674,685,250\n  verne modes --pose=-240,-86,1000 --csv"
     )]
     Modes(ModesArgs),
+    /// Compare the glider architectures (Wenger 2001): Tables 1 and 2, paper beside computed.
+    #[command(
+        after_help = "Example:\n  verne design\n  verne design --l 1000 --csv\n  verne design --bounds 1/2,2\n\nTable 1: L0, delta-rho per strut length L and S (largest rectangle) per L^2.\nTable 2: dimensions (m) and envelope (m^2) for a 1 m^2 rectangle, then a square.\n--csv columns: table,mechanism,target,quantity,unit,computed,paper,rel_diff.\n\nExit codes: 0 every mechanism designed, 1 some cannot meet the bounds, 2 fatal."
+    )]
+    Design(DesignArgs),
     /// Show the default machine file, or check one.
     #[command(subcommand)]
     Machine(MachineCommand),
+    /// Workspace on a grid: platform point, tool tip (eq. (27)) or manufacturing workspace
+    /// (eq. (26)), constraints (i)-(v) reported separately; volume, bounding box, largest box.
+    #[command(
+        after_help = "Example:\n  verne workspace --step 10\n  verne workspace --of tool --tool-length 0,50,100,150 --step 10\n  verne workspace --of manufacturing --step 10 -o points.csv --plot ws.svg --slice z=-50\n\nA point is inside when a branch with s=(-1,-1,-1) satisfies every constraint; otherwise its\n`status` is the binding constraint (the reference branch's first failure in the order\nrods_cross, rod_tilt, singularity, stroke, theta1_range) or out_of_reach.\nOutput columns (-o): tool_length,x,y,z,xp,yp,zp,alpha,rho1,rho2,rho3,lambda1,lambda2,lambda3,status,fails.\n\nExit codes: 0 ok, 1 some workspace is empty, 2 fatal."
+    )]
+    Workspace(WorkspaceArgs),
     /// Round-trip self-test of a machine file over a grid of joints: reports the worst residual.
     #[command(
         after_help = "Example:\n  verne selftest -m my_machine.toml --grid 16\n\nExit codes: 0 every round trip returned, 1 some did not, 2 fatal."
@@ -134,26 +145,7 @@ pub enum MachineCommand {
     },
 }
 
-/// Parses `a,b,c` into three finite numbers.
-pub fn parse_triple(s: &str) -> Result<[f64; 3], String> {
-    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
-    if parts.len() != 3 {
-        return Err(format!(
-            "expected three comma-separated numbers like 1,2,3, found {} value{}",
-            parts.len(),
-            if parts.len() == 1 { "" } else { "s" }
-        ));
-    }
-    let mut out = [0.0; 3];
-    for (k, p) in parts.iter().enumerate() {
-        match p.parse::<f64>() {
-            Ok(v) if v.is_finite() => out[k] = v,
-            Ok(_) => return Err(format!("value {} `{p}` is not a finite number", k + 1)),
-            Err(_) => return Err(format!("value {} `{p}` is not a number", k + 1)),
-        }
-    }
-    Ok(out)
-}
+pub use verne::arg_values::parse_triple;
 
 #[derive(Debug, Args)]
 pub struct SelftestArgs {
@@ -165,6 +157,175 @@ pub struct SelftestArgs {
     pub grid: u16,
 }
 
+/// Which point's workspace `verne workspace` samples.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum WorkspaceOf {
+    /// The platform point P (base frame, z down).
+    Platform,
+    /// The tool tip, eq. (27) (base frame).
+    Tool,
+    /// The tool tip in the table frame, the table following the platform (theta1 = alpha).
+    Manufacturing,
+}
+
+#[derive(Debug, Args)]
+pub struct WorkspaceArgs {
+    /// Which workspace. Default: platform, or tool when --tool-length is given.
+    #[arg(long, value_enum)]
+    pub of: Option<WorkspaceOf>,
+    /// Tool length(s) in mm, comma-separated: one workspace each, and a table of volume
+    /// against tool length. Default: the machine file's.
+    #[arg(
+        long = "tool-length",
+        value_name = "MM[,MM...]",
+        value_delimiter = ',',
+        allow_negative_numbers = true
+    )]
+    pub tool_length: Vec<f64>,
+    /// Grid step (mm), the same along x, y and z [default: 10 mm; for a glider, 801 nodes along
+    /// the longer side].
+    #[arg(long, value_name = "MM")]
+    pub step: Option<f64>,
+    /// Box sampled (mm, in the workspace's frame). Default: derived from the machine's rod
+    /// lengths, rod-tilt limit and strokes (docs/workspace.md).
+    #[arg(long, value_name = "XMIN,XMAX,YMIN,YMAX,ZMIN,ZMAX", value_parser = parse_bounds, allow_hyphen_values = true)]
+    pub bounds: Option<[f64; 6]>,
+    /// Bounds on the velocity amplification factors, constraint (iii). Default: 1/3,3.
+    #[arg(long, value_name = "LO,HI", value_parser = parse_pair, allow_hyphen_values = true)]
+    pub lambda: Option<[f64; 2]>,
+    /// Grid points CSV (written atomically; `-` writes stdout and moves the summary to stderr).
+    #[arg(short = 'o', long = "output", value_name = "POINTS.csv")]
+    pub output: Option<PathBuf>,
+    /// Write only the inside points to the CSV.
+    #[arg(long, requires = "output")]
+    pub inside_only: bool,
+    /// Picture of slices and projections, coloured by binding constraint (.svg or .png). With
+    /// several tool lengths, one file each, named FILE-L<length>.svg.
+    #[arg(long, value_name = "FILE.svg|png")]
+    pub plot: Option<PathBuf>,
+    /// A slice of the picture (repeatable): z=VALUE (horizontal), or x=VALUE, y=VALUE. Default:
+    /// three horizontal slices across the workspace.
+    #[arg(long, value_name = "z=VALUE", value_parser = parse_slice, requires = "plot", allow_hyphen_values = true)]
+    pub slice: Vec<(usize, f64)>,
+    #[command(flatten)]
+    pub common: CommonArgs,
+}
+
+fn parse_numbers<const N: usize>(s: &str, what: &str) -> Result<[f64; N], String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.len() != N {
+        return Err(format!(
+            "expected {N} comma-separated numbers ({what}), found {}",
+            parts.len()
+        ));
+    }
+    let mut out = [0.0; N];
+    for (k, p) in parts.iter().enumerate() {
+        match p.parse::<f64>() {
+            Ok(v) if v.is_finite() => out[k] = v,
+            _ => return Err(format!("value {} `{p}` is not a finite number", k + 1)),
+        }
+    }
+    Ok(out)
+}
+
+/// Parses `XMIN,XMAX,YMIN,YMAX,ZMIN,ZMAX`.
+pub fn parse_bounds(s: &str) -> Result<[f64; 6], String> {
+    let b = parse_numbers::<6>(s, "XMIN,XMAX,YMIN,YMAX,ZMIN,ZMAX")?;
+    for (d, name) in ["x", "y", "z"].iter().enumerate() {
+        if b[2 * d] > b[2 * d + 1] {
+            return Err(format!(
+                "{name}: min {} is above max {}",
+                b[2 * d],
+                b[2 * d + 1]
+            ));
+        }
+    }
+    Ok(b)
+}
+
+/// Parses `LO,HI`.
+pub fn parse_pair(s: &str) -> Result<[f64; 2], String> {
+    let p = parse_numbers::<2>(s, "LO,HI")?;
+    if !(0.0 <= p[0] && p[0] <= p[1]) {
+        return Err(format!("need 0 <= LO <= HI, got {},{}", p[0], p[1]));
+    }
+    Ok(p)
+}
+
+/// Parses `z=VALUE` (or x=, y=) into (axis, value).
+pub fn parse_slice(s: &str) -> Result<(usize, f64), String> {
+    let (axis, value) = s
+        .split_once('=')
+        .ok_or_else(|| format!("expected AXIS=VALUE like z=1100, got `{s}`"))?;
+    let axis = match axis.trim() {
+        "x" | "X" => 0,
+        "y" | "Y" => 1,
+        "z" | "Z" => 2,
+        other => return Err(format!("axis `{other}`: expected x, y or z")),
+    };
+    match value.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok((axis, v)),
+        _ => Err(format!("`{value}` is not a finite number")),
+    }
+}
+
+#[derive(Debug, Args)]
+pub struct DesignArgs {
+    /// Strut length L in mm: Table 1 also gives L0, delta-rho (mm) and S (mm^2).
+    #[arg(long = "l", value_name = "MM", value_parser = parse_positive)]
+    pub l: Option<f64>,
+    /// Bounds LO,HI on both velocity amplification factors, eq. (4); fractions like 1/3 allowed.
+    /// The paper's values are shown only for the paper's bounds 1/3,3.
+    #[arg(long, value_name = "LO,HI", value_parser = parse_lambda_bounds, default_value = "1/3,3")]
+    pub bounds: [f64; 2],
+    /// Workspace grid nodes along the longer side, for S (more: slower, S closer from below).
+    #[arg(long, value_name = "N", default_value_t = 1201, value_parser = clap::value_parser!(u32).range(11..=8001))]
+    pub nodes: u32,
+    /// CSV for a script (one row per quantity) instead of aligned tables.
+    #[arg(long)]
+    pub csv: bool,
+}
+
+/// Parses a number or a fraction `a/b`.
+fn parse_ratio(s: &str) -> Result<f64, String> {
+    let s = s.trim();
+    let v = match s.split_once('/') {
+        Some((a, b)) => match (a.trim().parse::<f64>(), b.trim().parse::<f64>()) {
+            (Ok(a), Ok(b)) => a / b,
+            _ => return Err(format!("`{s}` is not a number or a fraction like 1/3")),
+        },
+        None => s
+            .parse::<f64>()
+            .map_err(|_| format!("`{s}` is not a number or a fraction like 1/3"))?,
+    };
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(format!("`{s}` is not a finite number"))
+    }
+}
+
+/// Parses a finite number > 0.
+pub fn parse_positive(s: &str) -> Result<f64, String> {
+    match parse_ratio(s)? {
+        v if v > 0.0 => Ok(v),
+        v => Err(format!("{v} is not > 0")),
+    }
+}
+
+/// Parses `LO,HI` with 0 < LO < HI (numbers or fractions).
+pub fn parse_lambda_bounds(s: &str) -> Result<[f64; 2], String> {
+    let Some((lo, hi)) = s.split_once(',') else {
+        return Err("expected two comma-separated bounds like 1/3,3".into());
+    };
+    let (lo, hi) = (parse_ratio(lo)?, parse_ratio(hi)?);
+    if !(lo > 0.0 && lo < hi) {
+        return Err(format!("expected 0 < LO < HI, found LO = {lo}, HI = {hi}"));
+    }
+    Ok([lo, hi])
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -173,13 +334,5 @@ mod tests {
     #[test]
     fn cli_definition_is_consistent() {
         Cli::command().debug_assert();
-    }
-
-    #[test]
-    fn triples_parse_or_explain() {
-        assert_eq!(parse_triple("1, -2.5,3e2"), Ok([1.0, -2.5, 300.0]));
-        assert!(parse_triple("1,2").unwrap_err().contains("three"));
-        assert!(parse_triple("1,x,3").unwrap_err().contains("value 2"));
-        assert!(parse_triple("1,inf,3").unwrap_err().contains("finite"));
     }
 }

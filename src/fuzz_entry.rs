@@ -11,16 +11,29 @@ use crate::table::{CsvSource, Sink};
 
 /// CSV rows through the module inverse (`fk == false`) or forward kinematics, every branch.
 pub fn csv_rows(data: &[u8], fk: bool) {
-    let Ok(mut source) = CsvSource::from_reader(Box::new(Cursor::new(data.to_vec())), "fuzz") else {
+    let Ok(mut source) = CsvSource::from_reader(Box::new(Cursor::new(data.to_vec())), "fuzz")
+    else {
         return;
     };
     let mut sink = Sink::from_writer(Box::new(std::io::sink()), "sink");
     let machine = Machine::default_verne();
     let units = Units::default();
     let _ = if fk {
-        pipeline::run(&mut ModuleFk { machine, all: true }, &mut source, &mut sink, units, &|_| {})
+        pipeline::run(
+            &mut ModuleFk { machine, all: true },
+            &mut source,
+            &mut sink,
+            units,
+            &|_| {},
+        )
     } else {
-        pipeline::run(&mut ModuleIk { machine, all: true }, &mut source, &mut sink, units, &|_| {})
+        pipeline::run(
+            &mut ModuleIk { machine, all: true },
+            &mut source,
+            &mut sink,
+            units,
+            &|_| {},
+        )
     };
 }
 

@@ -11,7 +11,9 @@
 use nalgebra::{Matrix3, Matrix4, RowVector3, Vector3};
 
 use crate::machine::ModuleGeometry;
-use crate::module_geometry::{ModulePose, Sliders, jacobian_pose, jacobian_sliders, rod_lengths, rod_vectors};
+use crate::module_geometry::{
+    ModulePose, Sliders, jacobian_pose, jacobian_sliders, rod_lengths, rod_vectors,
+};
 
 /// Kinetostatic measures of one configuration.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -42,8 +44,8 @@ pub fn kinetostatics(g: &ModuleGeometry, pose: &ModulePose, rho: &Sliders) -> Ki
     let mut a = jacobian_pose(g, pose, rho);
     let mut b = jacobian_sliders(g, pose, rho);
     let l = rod_lengths(g);
-    for i in 0..4 {
-        let k = 1.0 / (2.0 * l[i]);
+    for (i, li) in l.iter().enumerate() {
+        let k = 1.0 / (2.0 * li);
         a.row_mut(i).scale_mut(k);
         b.row_mut(i).scale_mut(k);
     }
@@ -51,7 +53,11 @@ pub fn kinetostatics(g: &ModuleGeometry, pose: &ModulePose, rho: &Sliders) -> Ki
     let mut a_dimless: Matrix4<f64> = a;
     a_dimless.column_mut(3).scale_mut(1.0 / g.r_big2);
     let sv = a_dimless.singular_values();
-    let parallel_margin = if sv.max() > 0.0 { sv.min() / sv.max() } else { 0.0 };
+    let parallel_margin = if sv.max() > 0.0 {
+        sv.min() / sv.max()
+    } else {
+        0.0
+    };
     let v = rod_vectors(g, pose, rho);
     let serial_margin = (0..4).fold(f64::INFINITY, |m, i| m.min((v[i].z / l[i]).abs()));
     let (amplification, rotation_rate) = match a.lu().solve(&b) {
@@ -73,7 +79,12 @@ pub fn kinetostatics(g: &ModuleGeometry, pose: &ModulePose, rho: &Sliders) -> Ki
 }
 
 /// Velocity of P and alpha rate for given slider rates (the forward velocity map).
-pub fn pose_rates(g: &ModuleGeometry, pose: &ModulePose, rho: &Sliders, rho_rate: &Vector3<f64>) -> Option<(Vector3<f64>, f64)> {
+pub fn pose_rates(
+    g: &ModuleGeometry,
+    pose: &ModulePose,
+    rho: &Sliders,
+    rho_rate: &Vector3<f64>,
+) -> Option<(Vector3<f64>, f64)> {
     let a = jacobian_pose(g, pose, rho);
     let b = jacobian_sliders(g, pose, rho);
     let x = a.lu().solve(&(-(b * rho_rate)))?;
@@ -107,7 +118,9 @@ mod tests {
             assert!(((fp.alpha - fm.alpha) / (2.0 * h) - da).abs() < 1e-7);
         }
         let k = kinetostatics(&m.module, &w.pose, &rho);
-        assert!(k.amplification[0] >= k.amplification[1] && k.amplification[1] >= k.amplification[2]);
+        assert!(
+            k.amplification[0] >= k.amplification[1] && k.amplification[1] >= k.amplification[2]
+        );
         assert!(k.parallel_margin > 0.0 && k.parallel_margin <= 1.0);
         assert!(k.serial_margin > 0.0);
     }
@@ -117,7 +130,10 @@ mod tests {
         let m = Machine::default_verne();
         let g = m.module;
         // Put slider 2 level with its platform joint: rho2 = zp - R2 sin(alpha).
-        let pose = ModulePose { p: Vector3::new(-240.0, -86.0, 1000.0), alpha: 0.05 };
+        let pose = ModulePose {
+            p: Vector3::new(-240.0, -86.0, 1000.0),
+            alpha: 0.05,
+        };
         let rho = Sliders::new(368.0, pose.p.z - g.r_big2 * pose.alpha.sin(), 179.0);
         let k = kinetostatics(&g, &pose, &rho);
         assert!(k.serial_margin < 1e-12);

@@ -3,8 +3,11 @@
 //! The library computes; the binary (`src/main.rs`) talks. Nothing here prints or exits.
 
 pub mod apt;
+pub mod arg_values;
 pub mod branches;
 pub mod error;
+#[doc(hidden)]
+pub mod fuzz_entry;
 pub mod glider;
 pub mod jacobian;
 pub mod machine;
@@ -12,6 +15,7 @@ pub mod machine_kin;
 pub mod module_fk;
 pub mod module_geometry;
 pub mod module_ik;
+pub mod module_rows;
 pub mod orientation;
 pub mod pipeline;
 pub mod plot;
@@ -21,4 +25,3 @@ pub mod table;
 pub mod tolerance;
 pub mod trig;
 pub mod workspace;
-pub mod module_rows;

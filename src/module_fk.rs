@@ -197,6 +197,25 @@ fn fixed_alpha_points(g: &ModuleGeometry, rho: &Sliders, alpha: f64) -> ArrayVec
     out
 }
 
+/// The angles where Det = A cos(alpha) + B sin(alpha) + C vanishes (condition (21)): none, one
+/// or two; none when Det is identically zero or never zero.
+fn det_zeros(det: &Trig) -> ArrayVec<f64, 2> {
+    let (a, b, c) = (det.cos[1], det.sin[1], det.cos[0]);
+    let r = a.hypot(b);
+    let mut out = ArrayVec::new();
+    if r == 0.0 || !r.is_finite() || c.abs() > r {
+        return out;
+    }
+    // A cos + B sin = r cos(alpha - phi) = -C.
+    let phi = b.atan2(a);
+    let d = (-c / r).clamp(-1.0, 1.0).acos();
+    out.push(wrap_angle(phi - d));
+    if d != 0.0 {
+        out.push(wrap_angle(phi + d));
+    }
+    out
+}
+
 /// The real roots alpha of F, from both half-angle charts.
 fn characteristic_roots(f: &Trig) -> ArrayVec<f64, 32> {
     let mut alphas = ArrayVec::new();
@@ -229,35 +248,48 @@ pub fn solve(m: &Machine, rho: &Sliders) -> FkModes {
     }
     let elim = Elimination::new(g, rho);
     let f = elim.characteristic(g);
+    let mut starts: ArrayVec<ModulePose, 68> = ArrayVec::new();
     for alpha in characteristic_roots(&f) {
-        let starts: ArrayVec<ModulePose, 2> = match elim.back_substitute(g, rho, alpha) {
-            Some(p) => [p].into_iter().collect(),
-            None => fixed_alpha_points(g, rho, alpha),
-        };
-        for start in starts {
-            let pose = polish_pose(g, start, rho);
-            let pose = ModulePose {
-                alpha: wrap_angle(pose.alpha),
-                ..pose
-            };
-            if residual_mm(g, &pose, rho) > ACCEPT_RESIDUAL_MM {
-                continue;
-            }
-            let dup = out.iter().any(|o| {
-                wrap_angle(o.pose.alpha - pose.alpha).abs() < SAME_SOLUTION_RAD
-                    && (o.pose.p - pose.p).amax() < SAME_SOLUTION_MM * (1.0 + pose.p.amax())
-            });
-            if dup || out.is_full() {
-                continue;
-            }
-            let config = config_of(g, &pose, rho);
-            let verdict = module_verdict(m, &pose, rho, config);
-            out.push(FkMode {
-                pose,
-                config,
-                verdict,
-            });
+        match elim.back_substitute(g, rho, alpha) {
+            Some(p) => starts.push(p),
+            None => starts.extend(fixed_alpha_points(g, rho, alpha)),
         }
+    }
+    // Where condition (21) fails (Det = 0), a real solution forces b = 0 there and F then has
+    // (at least) a double root, F = 4 b^2 (Q^2 + delta^2 (R1^2 + r1^2 - 2 R1 r1 c)) >= 0, which
+    // floating-point root isolation can miss (it happens on a whole plane: L2 = L3, rho2 = rho3,
+    // alpha = 0, y_p = 0). Those (at most two) angles are tried directly on the four spheres,
+    // keeping only points that already solve them (elsewhere Newton could wander from these
+    // least-squares points and stop, unconverged, next to a solution found above).
+    for alpha in det_zeros(&elim.det) {
+        let on_spheres = fixed_alpha_points(g, rho, alpha)
+            .into_iter()
+            .filter(|p| residual_mm(g, p, rho) <= ACCEPT_RESIDUAL_MM);
+        starts.extend(on_spheres);
+    }
+    for start in starts {
+        let pose = polish_pose(g, start, rho);
+        let pose = ModulePose {
+            alpha: wrap_angle(pose.alpha),
+            ..pose
+        };
+        if residual_mm(g, &pose, rho) > ACCEPT_RESIDUAL_MM {
+            continue;
+        }
+        let dup = out.iter().any(|o| {
+            wrap_angle(o.pose.alpha - pose.alpha).abs() < SAME_SOLUTION_RAD
+                && (o.pose.p - pose.p).amax() < SAME_SOLUTION_MM * (1.0 + pose.p.amax())
+        });
+        if dup || out.is_full() {
+            continue;
+        }
+        let config = config_of(g, &pose, rho);
+        let verdict = module_verdict(m, &pose, rho, config);
+        out.push(FkMode {
+            pose,
+            config,
+            verdict,
+        });
     }
     out.sort_by(|a, b| {
         a.pose

@@ -1,6 +1,7 @@
 //! One file per subcommand; this file holds what they share: loading the machine, opening the
 //! input and output, and turning a run's summary into an exit code.
 
+pub mod design;
 pub mod fk;
 pub mod glider;
 pub mod ik;
@@ -8,6 +9,7 @@ pub mod machine;
 pub mod modes;
 pub mod selftest;
 pub mod shell;
+pub mod workspace;
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};

@@ -31,8 +31,24 @@ pub fn run(args: &ModesArgs) -> Result<u8, VerneError> {
     let (title, solutions) = query(&machine, args);
     let angle = if u.radians { "alpha_rad" } else { "alpha_deg" };
     let header = [
-        "branch", "xp", "yp", "zp", angle, "rho1", "rho2", "rho3", "s1", "s2", "s3", "working",
-        "det_a", "lambda_min", "lambda_max", "parallel_margin", "serial_margin", "status",
+        "branch",
+        "xp",
+        "yp",
+        "zp",
+        angle,
+        "rho1",
+        "rho2",
+        "rho3",
+        "s1",
+        "s2",
+        "s3",
+        "working",
+        "det_a",
+        "lambda_min",
+        "lambda_max",
+        "parallel_margin",
+        "serial_margin",
+        "status",
     ];
     let rows: Vec<Vec<Cell>> = solutions
         .iter()
@@ -44,7 +60,11 @@ pub fn run(args: &ModesArgs) -> Result<u8, VerneError> {
         .map(|r| r.iter().map(|c| cell_text(*c, u, args.csv)).collect())
         .collect();
     write_stdout(&render(&title, &header, &text_rows, args.csv))?;
-    Ok(if rows.is_empty() { EXIT_ROWS_FAILED } else { EXIT_OK })
+    Ok(if rows.is_empty() {
+        EXIT_ROWS_FAILED
+    } else {
+        EXIT_OK
+    })
 }
 
 /// Every branch of the query (`--pose`: inverse; `--joints`: forward) and a title line.
@@ -132,7 +152,13 @@ fn render(title: &str, header: &[&str], rows: &[Vec<String>], csv: bool) -> Stri
     text.push_str(title);
     text.push('\n');
     let widths: Vec<usize> = (0..header.len())
-        .map(|k| rows.iter().map(|r| r[k].len()).chain([header[k].len()]).max().unwrap_or(0))
+        .map(|k| {
+            rows.iter()
+                .map(|r| r[k].len())
+                .chain([header[k].len()])
+                .max()
+                .unwrap_or(0)
+        })
         .collect();
     let line = |cells: Vec<&str>| {
         let n = cells.len();
@@ -140,7 +166,13 @@ fn render(title: &str, header: &[&str], rows: &[Vec<String>], csv: bool) -> Stri
             .iter()
             .zip(&widths)
             .enumerate()
-            .map(|(k, (c, w))| if k + 1 == n { c.to_string() } else { format!("{c:>w$}") })
+            .map(|(k, (c, w))| {
+                if k + 1 == n {
+                    c.to_string()
+                } else {
+                    format!("{c:>w$}")
+                }
+            })
             .collect::<Vec<_>>()
             .join("  ")
     };
@@ -159,8 +191,15 @@ fn cell_text(c: Cell, u: Units, exact: bool) -> String {
     let units = if exact {
         u
     } else {
-        let d = if matches!(c, Cell::Angle(_)) && u.radians { 9 } else { 6 };
-        Units { decimals: Some(u.decimals.unwrap_or(d)), ..u }
+        let d = if matches!(c, Cell::Angle(_)) && u.radians {
+            9
+        } else {
+            6
+        };
+        Units {
+            decimals: Some(u.decimals.unwrap_or(d)),
+            ..u
+        }
     };
     write_cell(&mut out, c, units);
     String::from_utf8_lossy(&out).into_owned()

@@ -158,7 +158,8 @@ pub fn design_spec(name: &str, alpha1: f64, alpha2: f64, dims: Dimensions) -> Gl
 fn within_bounds(spec: &GliderSpec, rho: Vector2<f64>, [lo, hi]: [f64; 2]) -> bool {
     forward_kinematics_in_mode(spec, rho, Branch::Plus)
         .and_then(|p| amplification(spec, p, rho))
-        .is_some_and(|a| a.within(lo, hi))
+        // Exact comparison: the design solves lambda = bound (the workspace adds a slack).
+        .is_some_and(|a| a.lambda_min >= lo && a.lambda_max <= hi)
 }
 
 /// Bisection of a predicate between `good` (true) and `bad` (false) down to `tol`; returns the
@@ -178,20 +179,31 @@ fn bisect(mut good: f64, mut bad: f64, tol: f64, ok: impl Fn(f64) -> bool) -> f6
 /// Section 3.2, Wenger 2001: L0 and delta-rho of the glider with guide angles alpha1, alpha2
 /// and strut length L, from the amplification bounds [lo, hi] of eq. (4).
 ///
-/// Guides not parallel (biglide1, orthoglide): CD is longest with C on A and D on B (rho = 0,
+/// Converging guides (biglide1, orthoglide; |CD| shrinks as both sliders advance): CD is longest with C on A and D on B (rho = 0,
 /// the largest amplification); L0 is the largest distance < 2L at which both factors there meet
 /// the bounds. Then delta-rho is the largest range such that at rho = (delta-rho, delta-rho)
 /// (C on C', D on D', CD shortest) the factors still meet them.
 ///
-/// Parallel guides (biglide2, guides orthogonal to AB): CD is shortest when C and D are level
+/// Guides with the same direction (biglide2, guides orthogonal to AB): CD is shortest when C and D are level
 /// (rho1 = rho2); L0 is the smallest distance at which the factors there meet the bounds. Then
 /// delta-rho is the largest range such that at rho = (0, delta-rho) (C on A, D on D', CD
 /// longest) they still do.
 ///
 /// Each length is bracketed by a scan and refined by bisection to
-/// [`DESIGN_BISECTION_REL`] L. `None` if no length meets the bounds.
+/// [`DESIGN_BISECTION_REL`] L. `None` if no length meets the bounds, or if the guides diverge
+/// (|CD| grows as both sliders advance), a case the paper's rule does not cover.
 pub fn dimension(alpha1: f64, alpha2: f64, l: f64, bounds: [f64; 2]) -> Option<Dimensions> {
-    let parallel = (alpha1 - alpha2).sin().abs() < f64::EPSILON.sqrt();
+    let (u1, u2) = (
+        Vector2::new(alpha1.cos(), alpha1.sin()),
+        Vector2::new(alpha2.cos(), alpha2.sin()),
+    );
+    // Same guide direction (biglide2): moving both sliders together keeps |CD|. Otherwise the
+    // guides must converge (|CD| shrinks as both sliders advance, AB along +x); diverging guides
+    // are outside the rule of section 3.2.
+    let parallel = (u2 - u1).norm() < f64::EPSILON.sqrt();
+    if !parallel && u2.x - u1.x >= 0.0 {
+        return None;
+    }
     let spec_with = |l0: f64| {
         design_spec(
             "design",

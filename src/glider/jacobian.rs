@@ -85,7 +85,11 @@ pub fn singular_values_2x2(m: &Matrix2<f64>) -> (f64, f64) {
 /// Velocity amplification factors of section 2.7 at (P, rho): singular values of
 /// J = A^-1 B (eq. (3a)), computed as those of adj(A) B divided by |det A|. `None` at a
 /// parallel singularity, where the largest factor is unbounded.
-pub fn amplification(spec: &GliderSpec, p: Point2<f64>, rho: Vector2<f64>) -> Option<Amplification> {
+pub fn amplification(
+    spec: &GliderSpec,
+    p: Point2<f64>,
+    rho: Vector2<f64>,
+) -> Option<Amplification> {
     let j = jacobians(spec, p, rho);
     let det = j.a.determinant();
     if det.abs() / (spec.l1 * spec.l2) <= PARALLEL_SINGULAR_SIN {

@@ -11,7 +11,9 @@ use std::fmt;
 use nalgebra::{Point2, Vector2};
 
 use super::spec::GliderSpec;
-use super::tolerance::{COINCIDENT_REL, DOUBLE_ROOT_REL, PARALLEL_SINGULAR_SIN, SERIAL_SINGULAR_COS};
+use super::tolerance::{
+    COINCIDENT_REL, DOUBLE_ROOT_REL, PARALLEL_SINGULAR_SIN, SERIAL_SINGULAR_COS,
+};
 
 /// Which root of a quadratic a solution is: the `+` or `-` sign, or the double root where both
 /// meet.

@@ -304,12 +304,12 @@ pub fn largest_rectangle(grid: &WorkspaceGrid) -> Option<Rectangle> {
     let mut best: Option<(usize, usize, usize, usize, usize)> = None;
     let mut stack: Vec<(usize, usize)> = Vec::with_capacity(nx + 1);
     for j in 0..ny {
-        for i in 0..nx {
-            heights[i] = if grid.region[j * nx + i] { heights[i] + 1 } else { 0 };
+        for (h, &inside) in heights.iter_mut().zip(&grid.region[j * nx..(j + 1) * nx]) {
+            *h = if inside { *h + 1 } else { 0 };
         }
         stack.clear();
-        for c in 0..=nx {
-            let h = if c < nx { heights[c] } else { 0 };
+        // A zero-height sentinel column at c = nx flushes the stack.
+        for (c, &h) in heights.iter().chain(std::iter::once(&0)).enumerate() {
             let mut start = c;
             while let Some(&(s, hh)) = stack.last() {
                 if hh < h {

@@ -1,0 +1,215 @@
+#!/usr/bin/env bash
+# End-to-end benchmark of `verne ik` and `verne fk` against the I/O floor (src/bin/io_floor.rs),
+# plus the criterion kernels (benches/kernels.rs); writes the figures into docs/benchmarks.md
+# between the `bench.sh:begin` / `bench.sh:end` markers (the text around them is kept).
+#
+# Usage: scripts/bench.sh [--rows N] [--big] [--runs N] [--no-kernels] [--no-docs]
+#   --rows N      rows of the timing trajectory (default 1000000)
+#   --big         also run the 10,000,000-row memory check (peak RSS of verne ik and fk)
+#   --runs N      timed runs per command (default 5)
+#   --no-kernels  skip `cargo bench --bench kernels`
+#   --no-docs     print the figures, leave docs/benchmarks.md alone
+#
+# Timing uses hyperfine (installed with apt-get when missing and possible), else /usr/bin/time
+# (Debian package `time`, installed when missing); peak RSS always comes from /usr/bin/time -v.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+ROWS=1000000
+BIG_ROWS=10000000
+BIG=0
+RUNS=5
+KERNELS=1
+DOCS=1
+while [ $# -gt 0 ]; do
+    case "$1" in
+        --rows) ROWS="$2"; shift 2 ;;
+        --big) BIG=1; shift ;;
+        --runs) RUNS="$2"; shift 2 ;;
+        --no-kernels) KERNELS=0; shift ;;
+        --no-docs) DOCS=0; shift ;;
+        -h|--help) sed -n '2,14p' "$0"; exit 0 ;;
+        *) echo "bench.sh: unknown argument $1" >&2; exit 2 ;;
+    esac
+done
+
+log() { echo "bench.sh: $*" >&2; }
+
+apt_install() {
+    if command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = 0 ]; then
+        log "installing $1 with apt-get"
+        apt-get install -y -qq "$1" >/dev/null 2>&1 || {
+            apt-get update -qq >/dev/null 2>&1 && apt-get install -y -qq "$1" >/dev/null 2>&1
+        } || log "could not install $1"
+    else
+        log "$1 is missing and apt-get is not usable here"
+    fi
+}
+
+[ -x /usr/bin/time ] || apt_install time
+[ -x /usr/bin/time ] || { log "/usr/bin/time is required (Debian package time)"; exit 2; }
+command -v hyperfine >/dev/null 2>&1 || apt_install hyperfine
+HYPERFINE=$(command -v hyperfine || true)
+
+TARGET_DIR=${CARGO_TARGET_DIR:-target}
+WORK="$TARGET_DIR/bench-data"
+mkdir -p "$WORK"
+log "building release binaries"
+cargo build --release --bins 2>&1 | tail -1 >&2
+VERNE="$TARGET_DIR/release/verne"
+FLOOR="$TARGET_DIR/release/io_floor"
+
+# The trajectory: the kernels' helix (radius 120 mm around (-250, 0), 4096 rows per turn, about
+# 0.2 mm per row) rising from z = 1000 to 1300 mm over the file.
+gen_path() { # rows file
+    awk -v n="$1" 'BEGIN {
+        print "xp,yp,zp"; tau = 6.283185307179586
+        for (i = 0; i < n; i++) {
+            t = tau * i / 4096
+            printf "%.4f,%.4f,%.4f\n", -250 + 120 * cos(t), 120 * sin(t), 1000 + 300 * i / n
+        }
+    }' > "$2"
+}
+
+PATH_CSV="$WORK/path_$ROWS.csv"
+JOINTS_CSV="$WORK/joints_$ROWS.csv"
+[ -s "$PATH_CSV" ] || { log "generating $PATH_CSV"; gen_path "$ROWS" "$PATH_CSV"; }
+log "verne ik -> $JOINTS_CSV (the fk input)"
+"$VERNE" ik "$PATH_CSV" -o "$JOINTS_CSV"
+
+# time_cmd NAME CMD...: sets MEAN (s), USER (s), SYS (s) of the command (output to a file).
+time_cmd() {
+    local name=$1; shift
+    if [ -n "$HYPERFINE" ]; then
+        "$HYPERFINE" --style none --warmup 1 --runs "$RUNS" --export-csv "$WORK/$name.csv" \
+            -- "$(printf '%q ' "$@")" >/dev/null
+        # command,mean,stddev,median,user,system,min,max
+        read -r MEAN USER SYS < <(awk -F, 'NR == 2 { print $4, $5, $6 }' "$WORK/$name.csv")
+    else
+        local i
+        : > "$WORK/$name.times"
+        "$@" >/dev/null # warm-up
+        for ((i = 0; i < RUNS; i++)); do
+            /usr/bin/time -f "%e %U %S" -a -o "$WORK/$name.times" "$@" >/dev/null
+        done
+        read -r MEAN USER SYS < <(sort -n "$WORK/$name.times" | awk '{ e[NR] = $1; u[NR] = $2; s[NR] = $3 }
+            END { m = int((NR + 1) / 2); print e[m], u[m], s[m] }')
+    fi
+}
+
+# peak_rss CMD...: sets RSS_MB, the peak resident set size (MiB) from /usr/bin/time -v.
+peak_rss() {
+    /usr/bin/time -v -o "$WORK/rss.txt" "$@" >/dev/null 2>"$WORK/rss.err" || true
+    RSS_MB=$(awk -F: '/Maximum resident set size/ { printf "%.1f", $2 / 1024 }' "$WORK/rss.txt")
+}
+
+declare -A T U S R
+run_case() { # key CMD...
+    local key=$1; shift
+    log "timing $key"
+    time_cmd "$key" "$@"
+    T[$key]=$MEAN; U[$key]=$USER; S[$key]=$SYS
+    peak_rss "$@"
+    R[$key]=$RSS_MB
+}
+
+OUT="$WORK/out.csv"
+LOAD_BEFORE=$(cut -d' ' -f1-3 /proc/loadavg)
+run_case ik "$VERNE" ik "$PATH_CSV" -o "$OUT"
+run_case ik1 env RAYON_NUM_THREADS=1 "$VERNE" ik "$PATH_CSV" -o "$OUT"
+run_case floor_ik "$FLOOR" ik "$PATH_CSV" -o "$OUT"
+run_case fk "$VERNE" fk "$JOINTS_CSV" -o "$OUT"
+run_case fk1 env RAYON_NUM_THREADS=1 "$VERNE" fk "$JOINTS_CSV" -o "$OUT"
+run_case floor_fk "$FLOOR" fk "$JOINTS_CSV" -o "$OUT"
+rm -f "$OUT"
+
+BIG_IK=""; BIG_FK=""
+if [ "$BIG" = 1 ]; then
+    BIG_CSV="$WORK/path_$BIG_ROWS.csv"
+    BIG_JOINTS="$WORK/joints_$BIG_ROWS.csv"
+    [ -s "$BIG_CSV" ] || { log "generating $BIG_CSV"; gen_path "$BIG_ROWS" "$BIG_CSV"; }
+    log "memory check: verne ik on $BIG_ROWS rows"
+    /usr/bin/time -v -o "$WORK/rss.txt" "$VERNE" ik "$BIG_CSV" -o "$BIG_JOINTS" 2>/dev/null || true
+    BIG_IK=$(awk -F: '/Maximum resident set size/ { printf "%.1f", $2 / 1024 }' "$WORK/rss.txt")
+    log "memory check: verne fk on $BIG_ROWS rows"
+    peak_rss "$VERNE" fk "$BIG_JOINTS"
+    BIG_FK=$RSS_MB
+    rm -f "$BIG_JOINTS"
+fi
+
+KERNEL_TABLE=""
+if [ "$KERNELS" = 1 ]; then
+    log "cargo bench --bench kernels (a few minutes)"
+    VERNE_BENCH_SUMMARY="$WORK/kernels.md" cargo bench --bench kernels >"$WORK/kernels.log" 2>&1
+    KERNEL_TABLE=$(cat "$WORK/kernels.md")
+fi
+
+# ------------------------------------------------------------------------------- report
+rate() { awk -v n="$ROWS" -v t="$1" 'BEGIN { printf "%.2f M", n / t / 1e6 }'; }
+ratio() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.2f", a / b }'; }
+cpu() { awk -v u="$1" -v s="$2" 'BEGIN { printf "%.3f", u + s }'; }
+line() { # key floor-key label
+    local k=$1 f=$2
+    printf '| %s | %.3f | %s | %s | %s | %s | %s |\n' "$3" "${T[$k]}" "$(cpu "${U[$k]}" "${S[$k]}")" \
+        "$(rate "${T[$k]}")" "$(ratio "${T[$k]}" "${T[$f]}")" \
+        "$(ratio "$(cpu "${U[$k]}" "${S[$k]}")" "$(cpu "${U[$f]}" "${S[$f]}")")" "${R[$k]}"
+}
+
+LOAD_BEFORE=${LOAD_BEFORE:-?}
+LOAD_AFTER=$(cut -d' ' -f1-3 /proc/loadavg)
+CPU_MODEL=$(awk -F: '/model name/ { gsub(/^ +/, "", $2); print $2; exit }' /proc/cpuinfo)
+TOOL=$([ -n "$HYPERFINE" ] && echo "hyperfine $("$HYPERFINE" --version | awk '{print $2}') (median of $RUNS runs after 1 warm-up)" || echo "/usr/bin/time (median of $RUNS runs after 1 warm-up)")
+REPORT="$WORK/report.md"
+{
+    echo "Measured $(date -u +%Y-%m-%d) on $(nproc) cores ($CPU_MODEL), $(rustc --version), commit $(git rev-parse --short HEAD 2>/dev/null || echo '?') plus working tree; timing by $TOOL; peak RSS by /usr/bin/time -v. Load average (1, 5, 15 min) before the timings: $LOAD_BEFORE; after: $LOAD_AFTER (other work on the machine inflates wall times; the CPU columns are less affected)."
+    echo
+    echo "End to end, $ROWS rows (\`$PATH_CSV\`, helix, about 0.2 mm per row):"
+    echo
+    echo "| command | wall s | CPU s | rows/s (wall) | wall / floor | CPU / floor | peak RSS MiB |"
+    echo "|---|---:|---:|---:|---:|---:|---:|"
+    line ik floor_ik "\`verne ik\`"
+    line ik1 floor_ik "\`verne ik\`, RAYON_NUM_THREADS=1"
+    line floor_ik floor_ik "\`io_floor ik\`"
+    line fk floor_fk "\`verne fk\` (on the ik output)"
+    line fk1 floor_fk "\`verne fk\`, RAYON_NUM_THREADS=1"
+    line floor_fk floor_fk "\`io_floor fk\`"
+    if [ -n "$BIG_IK" ]; then
+        echo
+        echo "Memory check, $BIG_ROWS rows: peak RSS \`verne ik\` $BIG_IK MiB, \`verne fk\` $BIG_FK MiB (target < 32 MB)."
+    fi
+    echo
+    echo "Commands (\`scripts/bench.sh\` runs them):"
+    echo
+    echo '```sh'
+    echo "cargo build --release --bins"
+    echo "$VERNE ik $PATH_CSV -o $OUT"
+    echo "RAYON_NUM_THREADS=1 $VERNE ik $PATH_CSV -o $OUT"
+    echo "$FLOOR ik $PATH_CSV -o $OUT"
+    echo "$VERNE ik $PATH_CSV -o $JOINTS_CSV"
+    echo "$VERNE fk $JOINTS_CSV -o $OUT"
+    echo "RAYON_NUM_THREADS=1 $VERNE fk $JOINTS_CSV -o $OUT"
+    echo "$FLOOR fk $JOINTS_CSV -o $OUT"
+    [ -n "$BIG_IK" ] && echo "/usr/bin/time -v $VERNE ik $WORK/path_$BIG_ROWS.csv -o $WORK/joints_$BIG_ROWS.csv"
+    [ -n "$BIG_IK" ] && echo "/usr/bin/time -v $VERNE fk $WORK/joints_$BIG_ROWS.csv > /dev/null"
+    [ -n "$KERNEL_TABLE" ] && echo "VERNE_BENCH_SUMMARY=$WORK/kernels.md cargo bench --bench kernels"
+    echo '```'
+    if [ -n "$KERNEL_TABLE" ]; then
+        echo
+        echo "Kernels (\`cargo bench --bench kernels\`; medians of criterion's samples, ns per pose; every ratio is measured in the same run):"
+        echo
+        echo "$KERNEL_TABLE"
+    fi
+} > "$REPORT"
+cat "$REPORT"
+
+if [ "$DOCS" = 1 ]; then
+    DOC=docs/benchmarks.md
+    if [ ! -f "$DOC" ]; then
+        printf '# Benchmarks\n\n<!-- bench.sh:begin -->\n<!-- bench.sh:end -->\n' > "$DOC"
+    fi
+    awk -v report="$REPORT" '
+        /<!-- bench.sh:begin -->/ { print; while ((getline l < report) > 0) print l; skip = 1; next }
+        /<!-- bench.sh:end -->/ { skip = 0 }
+        !skip { print }' "$DOC" > "$DOC.tmp" && mv "$DOC.tmp" "$DOC"
+    log "updated $DOC"
+fi
