@@ -480,3 +480,91 @@ fn count(map: &mut BTreeMap<String, usize>, name: &str) {
         *map.entry(name.to_ascii_uppercase()).or_insert(0) += 1;
     }
 }
+
+/// A CL file read as CSV text (`line,kind,x,y,z,i,j,k`), so that `verne ik` streams it through
+/// the same row engine as a CSV file. A 3-value GOTO gets the axis (0, 0, 1). The reader's
+/// summary (skipped records) is shared through `summary`.
+pub struct AptAsCsv<R> {
+    reader: AptReader<R>,
+    buf: Vec<u8>,
+    pos: usize,
+    header_done: bool,
+    finished: bool,
+    summary: std::sync::Arc<std::sync::Mutex<AptSummary>>,
+}
+
+impl<R: BufRead> AptAsCsv<R> {
+    pub fn new(input: R) -> AptAsCsv<R> {
+        AptAsCsv {
+            reader: AptReader::new(input),
+            buf: Vec::with_capacity(256),
+            pos: 0,
+            header_done: false,
+            finished: false,
+            summary: Default::default(),
+        }
+    }
+
+    /// The reader's summary, updated as rows are read.
+    pub fn summary(&self) -> std::sync::Arc<std::sync::Mutex<AptSummary>> {
+        self.summary.clone()
+    }
+
+    fn refill(&mut self) -> std::io::Result<()> {
+        use std::io::Write;
+        self.buf.clear();
+        self.pos = 0;
+        if !self.header_done {
+            self.header_done = true;
+            self.buf.extend_from_slice(b"line,kind,x,y,z,i,j,k\n");
+            return Ok(());
+        }
+        if self.finished {
+            return Ok(());
+        }
+        let row = self.reader.next_row();
+        if let Ok(mut s) = self.summary.lock() {
+            *s = self.reader.summary().clone();
+        }
+        match row {
+            Ok(Some(r)) => {
+                let a = r.axis.unwrap_or(Vector3::new(0.0, 0.0, 1.0));
+                let kind = match r.kind {
+                    MotionKind::From => "FROM",
+                    MotionKind::Goto => "GOTO",
+                };
+                writeln!(
+                    self.buf,
+                    "{},{kind},{},{},{},{},{},{}",
+                    r.line, r.tip.x, r.tip.y, r.tip.z, a.x, a.y, a.z
+                )
+            }
+            Ok(None) => {
+                self.finished = true;
+                Ok(())
+            }
+            Err(e) => {
+                self.finished = true;
+                Err(std::io::Error::new(
+                    std::io::ErrorKind::InvalidData,
+                    e.to_string(),
+                ))
+            }
+        }
+    }
+}
+
+impl<R: BufRead> std::io::Read for AptAsCsv<R> {
+    fn read(&mut self, out: &mut [u8]) -> std::io::Result<usize> {
+        while self.pos >= self.buf.len() {
+            if self.finished && self.header_done {
+                return Ok(0);
+            }
+            self.refill()?;
+        }
+        let n = out.len().min(self.buf.len() - self.pos);
+        out[..n].copy_from_slice(&self.buf[self.pos..self.pos + n]);
+        self.pos += n;
+        Ok(n)
+    }
+}

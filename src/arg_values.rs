@@ -22,6 +22,114 @@ pub fn parse_triple(s: &str) -> Result<[f64; 3], String> {
     Ok(out)
 }
 
+pub fn parse_numbers<const N: usize>(s: &str, what: &str) -> Result<[f64; N], String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.len() != N {
+        return Err(format!(
+            "expected {N} comma-separated numbers ({what}), found {}",
+            parts.len()
+        ));
+    }
+    let mut out = [0.0; N];
+    for (k, p) in parts.iter().enumerate() {
+        match p.parse::<f64>() {
+            Ok(v) if v.is_finite() => out[k] = v,
+            _ => return Err(format!("value {} `{p}` is not a finite number", k + 1)),
+        }
+    }
+    Ok(out)
+}
+
+/// Parses `XMIN,XMAX,YMIN,YMAX,ZMIN,ZMAX`.
+pub fn parse_bounds(s: &str) -> Result<[f64; 6], String> {
+    let b = parse_numbers::<6>(s, "XMIN,XMAX,YMIN,YMAX,ZMIN,ZMAX")?;
+    for (d, name) in ["x", "y", "z"].iter().enumerate() {
+        if b[2 * d] > b[2 * d + 1] {
+            return Err(format!(
+                "{name}: min {} is above max {}",
+                b[2 * d],
+                b[2 * d + 1]
+            ));
+        }
+    }
+    Ok(b)
+}
+
+/// Parses `LO,HI`.
+pub fn parse_pair(s: &str) -> Result<[f64; 2], String> {
+    let p = parse_numbers::<2>(s, "LO,HI")?;
+    if !(0.0 <= p[0] && p[0] <= p[1]) {
+        return Err(format!("need 0 <= LO <= HI, got {},{}", p[0], p[1]));
+    }
+    Ok(p)
+}
+
+/// Parses `z=VALUE` (or x=, y=) into (axis, value).
+pub fn parse_slice(s: &str) -> Result<(usize, f64), String> {
+    let (axis, value) = s
+        .split_once('=')
+        .ok_or_else(|| format!("expected AXIS=VALUE like z=1100, got `{s}`"))?;
+    let axis = match axis.trim() {
+        "x" | "X" => 0,
+        "y" | "Y" => 1,
+        "z" | "Z" => 2,
+        other => return Err(format!("axis `{other}`: expected x, y or z")),
+    };
+    match value.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok((axis, v)),
+        _ => Err(format!("`{value}` is not a finite number")),
+    }
+}
+
+/// Parses a number or a fraction `a/b`.
+pub fn parse_ratio(s: &str) -> Result<f64, String> {
+    let s = s.trim();
+    let v = match s.split_once('/') {
+        Some((a, b)) => match (a.trim().parse::<f64>(), b.trim().parse::<f64>()) {
+            (Ok(a), Ok(b)) => a / b,
+            _ => return Err(format!("`{s}` is not a number or a fraction like 1/3")),
+        },
+        None => s
+            .parse::<f64>()
+            .map_err(|_| format!("`{s}` is not a number or a fraction like 1/3"))?,
+    };
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(format!("`{s}` is not a finite number"))
+    }
+}
+
+/// Parses a finite number > 0.
+pub fn parse_positive(s: &str) -> Result<f64, String> {
+    match parse_ratio(s)? {
+        v if v > 0.0 => Ok(v),
+        v => Err(format!("{v} is not > 0")),
+    }
+}
+
+/// Parses `LO,HI` with 0 < LO < HI (numbers or fractions).
+pub fn parse_lambda_bounds(s: &str) -> Result<[f64; 2], String> {
+    let Some((lo, hi)) = s.split_once(',') else {
+        return Err("expected two comma-separated bounds like 1/3,3".into());
+    };
+    let (lo, hi) = (parse_ratio(lo)?, parse_ratio(hi)?);
+    if !(lo > 0.0 && lo < hi) {
+        return Err(format!("expected 0 < LO < HI, found LO = {lo}, HI = {hi}"));
+    }
+    Ok([lo, hi])
+}
+
+/// Parses a tool pose `X,Y,Z,I,J,K` (tip in mm, axis) for `verne ik --tool`.
+pub fn parse_tool_pose(s: &str) -> Result<[f64; 6], String> {
+    parse_numbers::<6>(s, "X,Y,Z,I,J,K")
+}
+
+/// Parses machine joints `RHO1,RHO2,RHO3,THETA1,THETA2` for `verne fk --machine-joints`.
+pub fn parse_machine_joints(s: &str) -> Result<[f64; 5], String> {
+    parse_numbers::<5>(s, "RHO1,RHO2,RHO3,THETA1,THETA2")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

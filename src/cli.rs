@@ -84,13 +84,30 @@ pub struct CommonArgs {
 
 #[derive(Debug, Args)]
 pub struct IkArgs {
-    /// Input CSV with columns xp,yp,zp (mm); absent or `-` reads stdin.
+    /// Input: a CSV of tool poses (x,y,z with i,j,k or phi1,phi2; workpiece frame), a CSV of
+    /// platform points (xp,yp,zp), or an APT CL file (.cl/.apt); absent or `-` reads stdin.
     #[arg(value_name = "INPUT")]
     pub input: Option<PathBuf>,
-    /// One point XP,YP,ZP instead of an input file (repeatable). Use `--pose=-240,-86,1000`
-    /// for negative values.
-    #[arg(long, value_name = "XP,YP,ZP", value_parser = parse_triple, conflicts_with = "input")]
+    /// How to read INPUT (default: `apt` for a .cl or .apt file, else `csv`).
+    #[arg(long, value_enum, value_name = "FORMAT")]
+    pub input_format: Option<InputFormat>,
+    /// One platform point XP,YP,ZP instead of an input file (repeatable). Use
+    /// `--pose=-240,-86,1000` for negative values.
+    #[arg(long, value_name = "XP,YP,ZP", value_parser = parse_triple, conflicts_with_all = ["input", "tool"])]
     pub pose: Vec<[f64; 3]>,
+    /// One tool pose X,Y,Z,I,J,K (tip in mm and tool axis, workpiece frame) instead of an input
+    /// file (repeatable; rows of one path).
+    #[arg(long, value_name = "X,Y,Z,I,J,K", value_parser = parse_tool_pose, conflicts_with = "input", allow_hyphen_values = true)]
+    pub tool: Vec<[f64; 6]>,
+    /// Tool length Delta (mm), overriding the machine file's.
+    #[arg(long, value_name = "MM", value_parser = parse_positive)]
+    pub tool_length: Option<f64>,
+    /// On the first row of a path, which orientation solution to take when both are feasible.
+    #[arg(long, value_enum, default_value = "smallest-theta1")]
+    pub prefer: Prefer,
+    /// Output format: CSV, or a space-separated joint list for LinuxCNC's halstreamer.
+    #[arg(long, value_enum, default_value = "csv")]
+    pub format: OutputFormat,
     /// Output CSV (written atomically); absent or `-` writes stdout.
     #[arg(short = 'o', long = "output", value_name = "FILE")]
     pub output: Option<PathBuf>,
@@ -103,12 +120,20 @@ pub struct IkArgs {
 
 #[derive(Debug, Args)]
 pub struct FkArgs {
-    /// Input CSV with columns rho1,rho2,rho3 (mm); absent or `-` reads stdin.
+    /// Input CSV with columns rho1,rho2,rho3 (mm), and theta1,theta2 (the table) for the whole
+    /// machine; absent or `-` reads stdin.
     #[arg(value_name = "INPUT")]
     pub input: Option<PathBuf>,
-    /// One set of joints R1,R2,R3 instead of an input file (repeatable).
-    #[arg(long, value_name = "R1,R2,R3", value_parser = parse_triple, conflicts_with = "input")]
+    /// One set of slider positions R1,R2,R3 instead of an input file (repeatable).
+    #[arg(long, value_name = "R1,R2,R3", value_parser = parse_triple, conflicts_with_all = ["input", "machine_joints"])]
     pub joints: Vec<[f64; 3]>,
+    /// One set of machine joints RHO1,RHO2,RHO3,THETA1,THETA2 instead of an input file
+    /// (repeatable).
+    #[arg(long, value_name = "R1,R2,R3,T1,T2", value_parser = parse_machine_joints, conflicts_with = "input", allow_hyphen_values = true)]
+    pub machine_joints: Vec<[f64; 5]>,
+    /// Tool length Delta (mm), overriding the machine file's.
+    #[arg(long, value_name = "MM", value_parser = parse_positive)]
+    pub tool_length: Option<f64>,
     /// Output CSV (written atomically); absent or `-` writes stdout.
     #[arg(short = 'o', long = "output", value_name = "FILE")]
     pub output: Option<PathBuf>,
@@ -145,7 +170,33 @@ pub enum MachineCommand {
     },
 }
 
-pub use verne::arg_values::parse_triple;
+pub use verne::arg_values::*;
+
+/// How `verne ik` reads its input.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum InputFormat {
+    Csv,
+    Apt,
+}
+
+/// First-row orientation choice along a path.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Prefer {
+    /// The working branch with the smallest |theta1|.
+    SmallestTheta1,
+    /// Orientation solution 1: (phi1 >= 0, phi2).
+    Orientation1,
+    /// Orientation solution 2: (-phi1, phi2 + 180).
+    Orientation2,
+}
+
+/// Output format of `verne ik`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum OutputFormat {
+    Csv,
+    /// rho1 rho2 rho3 theta1 theta2 per line, no header (LinuxCNC halstreamer).
+    Halstreamer,
+}
 
 #[derive(Debug, Args)]
 pub struct SelftestArgs {
@@ -211,65 +262,6 @@ pub struct WorkspaceArgs {
     pub common: CommonArgs,
 }
 
-fn parse_numbers<const N: usize>(s: &str, what: &str) -> Result<[f64; N], String> {
-    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
-    if parts.len() != N {
-        return Err(format!(
-            "expected {N} comma-separated numbers ({what}), found {}",
-            parts.len()
-        ));
-    }
-    let mut out = [0.0; N];
-    for (k, p) in parts.iter().enumerate() {
-        match p.parse::<f64>() {
-            Ok(v) if v.is_finite() => out[k] = v,
-            _ => return Err(format!("value {} `{p}` is not a finite number", k + 1)),
-        }
-    }
-    Ok(out)
-}
-
-/// Parses `XMIN,XMAX,YMIN,YMAX,ZMIN,ZMAX`.
-pub fn parse_bounds(s: &str) -> Result<[f64; 6], String> {
-    let b = parse_numbers::<6>(s, "XMIN,XMAX,YMIN,YMAX,ZMIN,ZMAX")?;
-    for (d, name) in ["x", "y", "z"].iter().enumerate() {
-        if b[2 * d] > b[2 * d + 1] {
-            return Err(format!(
-                "{name}: min {} is above max {}",
-                b[2 * d],
-                b[2 * d + 1]
-            ));
-        }
-    }
-    Ok(b)
-}
-
-/// Parses `LO,HI`.
-pub fn parse_pair(s: &str) -> Result<[f64; 2], String> {
-    let p = parse_numbers::<2>(s, "LO,HI")?;
-    if !(0.0 <= p[0] && p[0] <= p[1]) {
-        return Err(format!("need 0 <= LO <= HI, got {},{}", p[0], p[1]));
-    }
-    Ok(p)
-}
-
-/// Parses `z=VALUE` (or x=, y=) into (axis, value).
-pub fn parse_slice(s: &str) -> Result<(usize, f64), String> {
-    let (axis, value) = s
-        .split_once('=')
-        .ok_or_else(|| format!("expected AXIS=VALUE like z=1100, got `{s}`"))?;
-    let axis = match axis.trim() {
-        "x" | "X" => 0,
-        "y" | "Y" => 1,
-        "z" | "Z" => 2,
-        other => return Err(format!("axis `{other}`: expected x, y or z")),
-    };
-    match value.trim().parse::<f64>() {
-        Ok(v) if v.is_finite() => Ok((axis, v)),
-        _ => Err(format!("`{value}` is not a finite number")),
-    }
-}
-
 #[derive(Debug, Args)]
 pub struct DesignArgs {
     /// Strut length L in mm: Table 1 also gives L0, delta-rho (mm) and S (mm^2).
@@ -285,45 +277,6 @@ pub struct DesignArgs {
     /// CSV for a script (one row per quantity) instead of aligned tables.
     #[arg(long)]
     pub csv: bool,
-}
-
-/// Parses a number or a fraction `a/b`.
-fn parse_ratio(s: &str) -> Result<f64, String> {
-    let s = s.trim();
-    let v = match s.split_once('/') {
-        Some((a, b)) => match (a.trim().parse::<f64>(), b.trim().parse::<f64>()) {
-            (Ok(a), Ok(b)) => a / b,
-            _ => return Err(format!("`{s}` is not a number or a fraction like 1/3")),
-        },
-        None => s
-            .parse::<f64>()
-            .map_err(|_| format!("`{s}` is not a number or a fraction like 1/3"))?,
-    };
-    if v.is_finite() {
-        Ok(v)
-    } else {
-        Err(format!("`{s}` is not a finite number"))
-    }
-}
-
-/// Parses a finite number > 0.
-pub fn parse_positive(s: &str) -> Result<f64, String> {
-    match parse_ratio(s)? {
-        v if v > 0.0 => Ok(v),
-        v => Err(format!("{v} is not > 0")),
-    }
-}
-
-/// Parses `LO,HI` with 0 < LO < HI (numbers or fractions).
-pub fn parse_lambda_bounds(s: &str) -> Result<[f64; 2], String> {
-    let Some((lo, hi)) = s.split_once(',') else {
-        return Err("expected two comma-separated bounds like 1/3,3".into());
-    };
-    let (lo, hi) = (parse_ratio(lo)?, parse_ratio(hi)?);
-    if !(lo > 0.0 && lo < hi) {
-        return Err(format!("expected 0 < LO < HI, found LO = {lo}, HI = {hi}"));
-    }
-    Ok([lo, hi])
 }
 
 #[cfg(test)]

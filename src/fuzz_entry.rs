@@ -53,6 +53,15 @@ pub fn apt_file(data: &[u8]) {
 /// The command-line value parsers, on any text.
 pub fn arg_values(data: &[u8]) {
     if let Ok(text) = std::str::from_utf8(data) {
-        let _ = crate::arg_values::parse_triple(text);
+        use crate::arg_values::*;
+        let _ = parse_triple(text);
+        let _ = parse_bounds(text);
+        let _ = parse_pair(text);
+        let _ = parse_slice(text);
+        let _ = parse_ratio(text);
+        let _ = parse_positive(text);
+        let _ = parse_lambda_bounds(text);
+        let _ = parse_tool_pose(text);
+        let _ = parse_machine_joints(text);
     }
 }

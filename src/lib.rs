@@ -12,6 +12,7 @@ pub mod glider;
 pub mod jacobian;
 pub mod machine;
 pub mod machine_kin;
+pub mod machine_rows;
 pub mod module_fk;
 pub mod module_geometry;
 pub mod module_ik;

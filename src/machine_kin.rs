@@ -564,7 +564,7 @@ pub struct PathState {
     prev: Option<PathRow>,
 }
 
-/// A candidate branch with the orientation it came from and its unwrapped theta2.
+/// A candidate branch with the orientation it came from and its theta2.
 #[derive(Clone, Copy)]
 struct Candidate {
     branch: MachineIkBranch,
@@ -576,6 +576,92 @@ struct Candidate {
 /// theta2 + 2 k pi nearest `reference`.
 fn unwrap_near(theta2: f64, reference: f64) -> f64 {
     reference + wrap_angle(theta2 - reference)
+}
+
+/// Every branch of one path row over the orientation solutions, before the choice that
+/// depends on the previous row (so rows can be solved in parallel and chosen in order).
+#[derive(Clone, Default)]
+pub struct PathCandidates {
+    options: ArrayVec<(ToolAngles, u8), 2>,
+    all: ArrayVec<Candidate, { 2 * MAX_MACHINE_IK_BRANCHES }>,
+    near_singular: bool,
+    needs_previous: bool,
+}
+
+impl PathCandidates {
+    /// True for an axis inside the rotary-singularity cone: the candidates were computed with
+    /// theta2 = 0 and must be recomputed with the previous row's theta2.
+    pub fn needs_previous(&self) -> bool {
+        self.needs_previous
+    }
+
+    /// Every branch with its orientation solution (1 or 2) and theta2 (rad, in (-pi, pi]).
+    pub fn iter(&self) -> impl Iterator<Item = (MachineIkBranch, u8, f64)> + '_ {
+        self.all.iter().map(|c| (c.branch, c.orientation, c.theta2))
+    }
+
+    /// Number of real branches.
+    pub fn len(&self) -> usize {
+        self.all.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.all.is_empty()
+    }
+}
+
+/// The candidates of one row: both orientation solutions of an axis (or the given angles), every
+/// machine IK branch of each, theta2 = -phi2 wrapped to (-pi, pi]. Inside the rotary cone, phi2 is
+/// taken from `prev_theta2` (0 when None) and phi1 fitted to it.
+pub fn path_candidates(
+    m: &Machine,
+    tip: &Vector3<f64>,
+    orientation: &ToolOrientation,
+    tool_length: f64,
+    prev_theta2: Option<f64>,
+) -> Result<PathCandidates, PathError> {
+    let mut out = PathCandidates::default();
+    match orientation {
+        ToolOrientation::Angles(a) => {
+            out.near_singular = a.phi1.sin().abs() < crate::orientation::ROTARY_SINGULAR_CONE_RAD;
+            out.options.push((*a, 1));
+        }
+        ToolOrientation::Axis(v) => match axis_angles(v).map_err(PathError::Axis)? {
+            AxisAngles::Regular(sols) => {
+                out.options.push((sols[0], 1));
+                out.options.push((sols[1], 2));
+            }
+            AxisAngles::NearRotary { .. } => {
+                out.near_singular = true;
+                out.needs_previous = true;
+                let a = unit_axis(v).map_err(PathError::Axis)?;
+                let phi2 = -prev_theta2.unwrap_or(0.0);
+                out.options.push((
+                    ToolAngles {
+                        phi1: phi1_at(&a, phi2),
+                        phi2,
+                    },
+                    1,
+                ));
+            }
+        },
+    }
+    for &(angles, label) in &out.options {
+        let pose = ToolPose {
+            tip: *tip,
+            phi1: angles.phi1,
+            phi2: angles.phi2,
+        };
+        for branch in machine_ik(m, &pose, tool_length) {
+            out.all.push(Candidate {
+                branch,
+                angles,
+                orientation: label,
+                theta2: wrap_angle(-angles.phi2),
+            });
+        }
+    }
+    Ok(out)
 }
 
 impl PathState {
@@ -599,52 +685,26 @@ impl PathState {
         tool_length: f64,
     ) -> Result<PathRow, PathError> {
         let prev_theta2 = self.prev.map(|p| p.theta2);
-        let mut near_singular = false;
-        let mut options: ArrayVec<(ToolAngles, u8), 2> = ArrayVec::new();
-        match orientation {
-            ToolOrientation::Angles(a) => {
-                near_singular = a.phi1.sin().abs() < crate::orientation::ROTARY_SINGULAR_CONE_RAD;
-                options.push((*a, 1));
-            }
-            ToolOrientation::Axis(v) => match axis_angles(v).map_err(PathError::Axis)? {
-                AxisAngles::Regular(sols) => {
-                    options.push((sols[0], 1));
-                    options.push((sols[1], 2));
-                }
-                AxisAngles::NearRotary { .. } => {
-                    near_singular = true;
-                    let a = unit_axis(v).map_err(PathError::Axis)?;
-                    let phi2 = -prev_theta2.unwrap_or(0.0);
-                    options.push((
-                        ToolAngles {
-                            phi1: phi1_at(&a, phi2),
-                            phi2,
-                        },
-                        1,
-                    ));
-                }
-            },
-        }
-        let mut all: ArrayVec<Candidate, { 2 * MAX_MACHINE_IK_BRANCHES }> = ArrayVec::new();
-        for &(angles, label) in &options {
-            let pose = ToolPose {
-                tip: *tip,
-                phi1: angles.phi1,
-                phi2: angles.phi2,
-            };
-            for branch in machine_ik(m, &pose, tool_length) {
-                let theta2 = match prev_theta2 {
-                    Some(p) => unwrap_near(-angles.phi2, p),
-                    None => wrap_angle(-angles.phi2),
-                };
-                all.push(Candidate {
-                    branch,
-                    angles,
-                    orientation: label,
-                    theta2,
-                });
-            }
-        }
+        let candidates = path_candidates(m, tip, orientation, tool_length, prev_theta2)?;
+        self.choose(&candidates)
+    }
+
+    /// Chooses among the candidates of one row (from [`path_candidates`], computed with this
+    /// state's previous theta2 when [`PathCandidates::needs_previous`] says so).
+    pub fn choose(&mut self, candidates: &PathCandidates) -> Result<PathRow, PathError> {
+        let options = &candidates.options;
+        let near_singular = candidates.near_singular;
+        let all: ArrayVec<Candidate, { 2 * MAX_MACHINE_IK_BRANCHES }> = candidates
+            .all
+            .iter()
+            .map(|c| Candidate {
+                theta2: match self.prev {
+                    Some(p) => unwrap_near(c.theta2, p.theta2),
+                    None => c.theta2,
+                },
+                ..*c
+            })
+            .collect();
         let machine_kind = |c: &&Candidate| c.branch.working() || c.branch.verdict.only_limits();
         let (chosen, switched) = match self.prev {
             Some(prev) => {

@@ -40,7 +40,13 @@ pub struct Units {
     pub radians: bool,
     /// Fixed decimals for numbers (default: shortest round-trip form).
     pub decimals: Option<usize>,
+    /// `--format halstreamer`: only the joints [`HALSTREAMER_COLUMNS`], no header, and a row
+    /// that is not ok stops the run (a joint list for LinuxCNC's halstreamer cannot skip one).
+    pub halstreamer: bool,
 }
+
+/// The columns of a halstreamer joint list, in order.
+pub const HALSTREAMER_COLUMNS: [&str; 5] = ["rho1", "rho2", "rho3", "theta1", "theta2"];
 
 /// The outcome of one input row, for the exit code and the summary.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -192,20 +198,32 @@ pub fn run<J: RowJob>(
     // Output plan: input columns (computed ones replace same-named inputs), then the rest.
     let mut plan = Vec::new();
     let mut header = ByteRecord::new();
-    for (i, h) in source.headers().iter().enumerate() {
-        match outputs.iter().position(|o| o.as_bytes() == h) {
-            Some(k) => plan.push(Slot::Computed(k)),
-            None => plan.push(Slot::Input(i)),
-        }
-        header.push_field(h);
-    }
-    for (k, o) in outputs.iter().enumerate() {
-        if source.column(o).is_none() {
+    if units.halstreamer {
+        for name in HALSTREAMER_COLUMNS {
+            let Some(k) = outputs.iter().position(|o| *o == name) else {
+                return Err(VerneError::Usage(format!(
+                    "--format halstreamer writes the machine joints {}; this input gives no `{name}` (use tool poses x,y,z with i,j,k or phi1,phi2)",
+                    HALSTREAMER_COLUMNS.join(",")
+                )));
+            };
             plan.push(Slot::Computed(k));
-            header.push_field(o.as_bytes());
         }
+    } else {
+        for (i, h) in source.headers().iter().enumerate() {
+            match outputs.iter().position(|o| o.as_bytes() == h) {
+                Some(k) => plan.push(Slot::Computed(k)),
+                None => plan.push(Slot::Input(i)),
+            }
+            header.push_field(h);
+        }
+        for (k, o) in outputs.iter().enumerate() {
+            if source.column(o).is_none() {
+                plan.push(Slot::Computed(k));
+                header.push_field(o.as_bytes());
+            }
+        }
+        sink.write(&header)?;
     }
-    sink.write(&header)?;
     let status_col = outputs.len() - 1;
     let file = source.name().to_string();
     let mut summary = RunSummary::default();
@@ -312,6 +330,16 @@ pub fn run<J: RowJob>(
                 scratch.clear();
                 write_cell(&mut scratch, outcome.status, units);
                 let text = String::from_utf8_lossy(&scratch).into_owned();
+                if units.halstreamer {
+                    return Err(VerneError::input(
+                        &file,
+                        Some(line),
+                        None,
+                        format!(
+                            "row status `{text}`: a halstreamer joint list cannot leave out a row; fix the path or use CSV output to see every row's status"
+                        ),
+                    ));
+                }
                 summary.count(&text, line);
             }
             spare.push(row);

@@ -217,6 +217,11 @@ pub struct Sink {
 impl Sink {
     /// `None` or `-` is stdout; a path is written through a temporary file in the same directory.
     pub fn create(path: Option<&Path>) -> Result<Sink, VerneError> {
+        Sink::create_delimited(path, b',')
+    }
+
+    /// As [`Sink::create`], with another field delimiter (b' ' for halstreamer).
+    pub fn create_delimited(path: Option<&Path>, delimiter: u8) -> Result<Sink, VerneError> {
         let (inner, target, name): (Box<dyn Write + Send>, _, String) = match path {
             Some(p) if p.as_os_str() != "-" => {
                 let name = p.display().to_string();
@@ -238,7 +243,9 @@ impl Sink {
             crate::table::register_temp(tmp);
         }
         Ok(Sink {
-            writer: csv::WriterBuilder::new().from_writer(inner),
+            writer: csv::WriterBuilder::new()
+                .delimiter(delimiter)
+                .from_writer(inner),
             target,
             name,
         })

@@ -1,6 +1,8 @@
-//! `verne fk`: joints -> platform pose of the parallel module (IFToMM 2007, section VI).
+//! `verne fk`: machine joints -> tool pose in the workpiece frame, or slider positions -> platform
+//! pose of the parallel module (IFToMM 2007, section VI).
 
 use verne::error::VerneError;
+use verne::machine_rows::MachineFk;
 use verne::module_rows::ModuleFk;
 use verne::table::CsvSource;
 
@@ -12,20 +14,37 @@ pub fn run(args: &FkArgs) -> Result<u8, VerneError> {
         return super::glider::fk(args, spec);
     }
     let machine = load_machine(args.common.machine.as_deref())?;
-    let source = if args.joints.is_empty() {
-        CsvSource::open(args.input.as_deref())?
+    let u = units(&args.common);
+    let source = if !args.joints.is_empty() {
+        inline_source(
+            "rho1,rho2,rho3",
+            &args.joints.iter().map(|j| j.to_vec()).collect::<Vec<_>>(),
+        )?
+    } else if !args.machine_joints.is_empty() {
+        inline_source(
+            "rho1,rho2,rho3,theta1,theta2",
+            &args
+                .machine_joints
+                .iter()
+                .map(|j| j.to_vec())
+                .collect::<Vec<_>>(),
+        )?
     } else {
-        inline_source("rho1,rho2,rho3", &args.joints)?
+        CsvSource::open(args.input.as_deref())?
     };
-    let mut job = ModuleFk {
-        machine,
-        all: args.all,
-    };
-    run_rows(
-        "fk",
-        &mut job,
-        source,
-        args.output.as_ref(),
-        units(&args.common),
-    )
+    let table = source.column("theta1").is_some() || source.column("theta2").is_some();
+    if table {
+        let mut job = MachineFk {
+            tool_length: args.tool_length.unwrap_or(machine.tool_length),
+            machine,
+            all: args.all,
+        };
+        run_rows("fk", &mut job, source, args.output.as_ref(), u)
+    } else {
+        let mut job = ModuleFk {
+            machine,
+            all: args.all,
+        };
+        run_rows("fk", &mut job, source, args.output.as_ref(), u)
+    }
 }

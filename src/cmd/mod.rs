@@ -54,14 +54,17 @@ pub fn units(common: &CommonArgs) -> Units {
     Units {
         radians: common.radians,
         decimals: common.precision.map(usize::from),
+        halstreamer: false,
     }
 }
 
 /// The rows given on the command line as an in-memory CSV with `header`.
-pub fn inline_source(header: &str, rows: &[[f64; 3]]) -> Result<CsvSource, VerneError> {
+pub fn inline_source(header: &str, rows: &[Vec<f64>]) -> Result<CsvSource, VerneError> {
     let mut text = format!("{header}\n");
     for r in rows {
-        text.push_str(&format!("{},{},{}\n", r[0], r[1], r[2]));
+        let cells: Vec<String> = r.iter().map(f64::to_string).collect();
+        text.push_str(&cells.join(","));
+        text.push('\n');
     }
     CsvSource::from_reader(
         Box::new(std::io::Cursor::new(text.into_bytes())),
@@ -78,7 +81,8 @@ pub fn run_rows<J: RowJob>(
     output: Option<&PathBuf>,
     units: Units,
 ) -> Result<u8, VerneError> {
-    let mut sink = Sink::create(output.map(PathBuf::as_path))?;
+    let delimiter = if units.halstreamer { b' ' } else { b',' };
+    let mut sink = Sink::create_delimited(output.map(PathBuf::as_path), delimiter)?;
     let bar = progress_bar();
     let tick = |n: u64| {
         if let Some(b) = &bar {

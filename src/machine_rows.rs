@@ -1,0 +1,316 @@
+//! The whole 5-axis machine as row jobs (`verne ik` on tool poses, `verne fk` on five joints):
+//! tool tip and axis in the workpiece frame <-> (rho1, rho2, rho3, theta1, theta2).
+
+use nalgebra::Vector3;
+
+use crate::error::VerneError;
+use crate::machine::Machine;
+use crate::machine_kin::{
+    FirstRowChoice, MachineFkModes, PathCandidates, PathError, PathState, machine_fk,
+    path_candidates,
+};
+use crate::module_geometry::Sliders;
+use crate::module_rows::emit_branches;
+use crate::orientation::{ToolAngles, ToolOrientation};
+use crate::pipeline::{Cell, RowJob, RowOutcome, RowWriter};
+
+/// How the tool orientation is given in the input.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OrientationColumns {
+    /// `i,j,k`: the tool axis, tip towards spindle (CAM convention).
+    Axis,
+    /// `phi1,phi2`: the angles of AIM 2007 eq. (8).
+    Angles,
+}
+
+impl OrientationColumns {
+    /// Chooses from a header: `i,j,k` or `phi1,phi2`, exactly one of the two.
+    pub fn detect(has: impl Fn(&str) -> bool) -> Result<OrientationColumns, String> {
+        let axis = ["i", "j", "k"].iter().filter(|c| has(c)).count();
+        let angles = ["phi1", "phi2"].iter().filter(|c| has(c)).count();
+        match (axis, angles) {
+            (3, 0) => Ok(OrientationColumns::Axis),
+            (0, 2) => Ok(OrientationColumns::Angles),
+            (0, 0) => Err(
+                "tool poses need the tool axis `i,j,k` or the angles `phi1,phi2` besides `x,y,z`"
+                    .into(),
+            ),
+            (3, 2) => Err("both `i,j,k` and `phi1,phi2` are present: keep one orientation".into()),
+            _ => Err(
+                "incomplete orientation columns: expected all of `i,j,k` or both `phi1,phi2`"
+                    .into(),
+            ),
+        }
+    }
+}
+
+/// Machine IK along a path (default) or every branch of every row (`all`).
+pub struct MachineIk {
+    pub machine: Machine,
+    pub tool_length: f64,
+    pub orientation: OrientationColumns,
+    pub all: bool,
+    pub state: PathState,
+}
+
+impl MachineIk {
+    pub fn new(
+        machine: Machine,
+        tool_length: f64,
+        orientation: OrientationColumns,
+        all: bool,
+        first: FirstRowChoice,
+    ) -> MachineIk {
+        MachineIk {
+            machine,
+            tool_length,
+            orientation,
+            all,
+            state: PathState::new(first),
+        }
+    }
+}
+
+const IK_AXIS_INPUTS: &[(&str, bool)] = &[
+    ("x", false),
+    ("y", false),
+    ("z", false),
+    ("i", false),
+    ("j", false),
+    ("k", false),
+];
+const IK_ANGLE_INPUTS: &[(&str, bool)] = &[
+    ("x", false),
+    ("y", false),
+    ("z", false),
+    ("phi1", true),
+    ("phi2", true),
+];
+const IK_OUT_PATH: &[&str] = &[
+    "rho1",
+    "rho2",
+    "rho3",
+    "theta1",
+    "theta2",
+    "orientation",
+    "flags",
+    "status",
+];
+const IK_OUT_ALL: &[&str] = &[
+    "branch",
+    "orientation",
+    "rho1",
+    "rho2",
+    "rho3",
+    "theta1",
+    "theta2",
+    "s1",
+    "s2",
+    "s3",
+    "working",
+    "status",
+];
+
+/// One row's solve result: the tip and orientation read, and the candidates computed with no
+/// previous row (recomputed in order when the axis is inside the rotary cone).
+#[derive(Default)]
+pub struct SolvedToolPose {
+    tip: Vector3<f64>,
+    orientation: Option<ToolOrientation>,
+    candidates: Option<Result<PathCandidates, PathError>>,
+}
+
+impl MachineIk {
+    fn orientation_of(&self, inputs: &[f64]) -> ToolOrientation {
+        match self.orientation {
+            OrientationColumns::Axis => {
+                ToolOrientation::Axis(Vector3::new(inputs[3], inputs[4], inputs[5]))
+            }
+            OrientationColumns::Angles => ToolOrientation::Angles(ToolAngles {
+                phi1: inputs[3],
+                phi2: inputs[4],
+            }),
+        }
+    }
+}
+
+impl RowJob for MachineIk {
+    type Solved = SolvedToolPose;
+
+    fn inputs(&self) -> &[(&'static str, bool)] {
+        match self.orientation {
+            OrientationColumns::Axis => IK_AXIS_INPUTS,
+            OrientationColumns::Angles => IK_ANGLE_INPUTS,
+        }
+    }
+
+    fn outputs(&self) -> &[&'static str] {
+        if self.all { IK_OUT_ALL } else { IK_OUT_PATH }
+    }
+
+    fn solve(&self, inputs: &[f64], solved: &mut SolvedToolPose) {
+        let tip = Vector3::new(inputs[0], inputs[1], inputs[2]);
+        let orientation = self.orientation_of(inputs);
+        solved.tip = tip;
+        solved.orientation = Some(orientation);
+        solved.candidates = Some(path_candidates(
+            &self.machine,
+            &tip,
+            &orientation,
+            self.tool_length,
+            None,
+        ));
+    }
+
+    fn emit(
+        &mut self,
+        solved: &SolvedToolPose,
+        out: &mut RowWriter<'_>,
+    ) -> Result<RowOutcome, VerneError> {
+        let Some(candidates) = &solved.candidates else {
+            return Err(VerneError::Usage(
+                "internal: row emitted before it was solved".into(),
+            ));
+        };
+        let recomputed;
+        let candidates = match (candidates, solved.orientation, self.state.previous()) {
+            (Ok(c), Some(o), Some(prev)) if c.needs_previous() && !self.all => {
+                recomputed = path_candidates(
+                    &self.machine,
+                    &solved.tip,
+                    &o,
+                    self.tool_length,
+                    Some(prev.theta2),
+                );
+                &recomputed
+            }
+            _ => candidates,
+        };
+        let candidates = match candidates {
+            Ok(c) => c,
+            Err(e) => return bad_row(out, e, self.all),
+        };
+        if self.all {
+            let branches: Vec<_> = candidates.iter().collect();
+            return emit_branches(out, true, &branches, None, |(b, orientation, theta2)| {
+                let values = [
+                    Cell::Int((*orientation).into()),
+                    Cell::Num(b.rho.x),
+                    Cell::Num(b.rho.y),
+                    Cell::Num(b.rho.z),
+                    Cell::Angle(b.theta1),
+                    Cell::Angle(*theta2),
+                ];
+                (values, b.config, b.verdict)
+            });
+        }
+        match self.state.choose(candidates) {
+            Ok(row) => {
+                let flags = match (row.near_rotary_singularity, row.switched) {
+                    (true, true) => "near_rotary_singularity;orientation_switch",
+                    (true, false) => "near_rotary_singularity",
+                    (false, true) => "orientation_switch",
+                    (false, false) => "",
+                };
+                out.row(&[
+                    Cell::Num(row.rho.x),
+                    Cell::Num(row.rho.y),
+                    Cell::Num(row.rho.z),
+                    Cell::Angle(row.theta1),
+                    Cell::Angle(row.theta2),
+                    Cell::Int(row.orientation.into()),
+                    Cell::Str(flags),
+                    Cell::Str("ok"),
+                ])?;
+                Ok(RowOutcome {
+                    ok: true,
+                    status: Cell::Str("ok"),
+                })
+            }
+            Err(e) => bad_row(out, &e, false),
+        }
+    }
+}
+
+/// A row with no joints: empty cells and why.
+fn bad_row(out: &mut RowWriter<'_>, e: &PathError, all: bool) -> Result<RowOutcome, VerneError> {
+    let status = match e {
+        PathError::Axis(_) => Cell::Str("invalid_axis"),
+        PathError::NoWorkingBranch {
+            real_branches: 0, ..
+        } => Cell::Str("unreachable"),
+        PathError::NoWorkingBranch {
+            nearest: Some(b), ..
+        } if b.verdict.only_limits() => Cell::Verdict(b.verdict),
+        PathError::NoWorkingBranch { .. } => Cell::Str("no_working_branch"),
+    };
+    let n = if all {
+        IK_OUT_ALL.len()
+    } else {
+        IK_OUT_PATH.len()
+    };
+    let mut cells = vec![Cell::Empty; n];
+    cells[n - 1] = status;
+    out.row(&cells)?;
+    Ok(RowOutcome { ok: false, status })
+}
+
+/// Machine FK: joints -> tool tip, axis and (phi1, phi2) in the workpiece frame.
+pub struct MachineFk {
+    pub machine: Machine,
+    pub tool_length: f64,
+    pub all: bool,
+}
+
+const FK_INPUTS: &[(&str, bool)] = &[
+    ("rho1", false),
+    ("rho2", false),
+    ("rho3", false),
+    ("theta1", true),
+    ("theta2", true),
+];
+const FK_OUT_WORKING: &[&str] = &["x", "y", "z", "i", "j", "k", "phi1", "phi2", "status"];
+const FK_OUT_ALL: &[&str] = &[
+    "branch", "x", "y", "z", "i", "j", "k", "phi1", "phi2", "s1", "s2", "s3", "working", "status",
+];
+
+impl RowJob for MachineFk {
+    type Solved = MachineFkModes;
+
+    fn inputs(&self) -> &[(&'static str, bool)] {
+        FK_INPUTS
+    }
+
+    fn outputs(&self) -> &[&'static str] {
+        if self.all { FK_OUT_ALL } else { FK_OUT_WORKING }
+    }
+
+    fn solve(&self, inputs: &[f64], solved: &mut MachineFkModes) {
+        let rho = Sliders::new(inputs[0], inputs[1], inputs[2]);
+        *solved = machine_fk(&self.machine, &rho, inputs[3], inputs[4], self.tool_length);
+    }
+
+    fn emit(
+        &mut self,
+        modes: &MachineFkModes,
+        out: &mut RowWriter<'_>,
+    ) -> Result<RowOutcome, VerneError> {
+        let working = modes
+            .iter()
+            .filter(|m| m.working())
+            .min_by(|a, b| a.module.alpha.abs().total_cmp(&b.module.alpha.abs()));
+        emit_branches(out, self.all, modes, working, |m| {
+            let values = [
+                Cell::Num(m.tool.tip.x),
+                Cell::Num(m.tool.tip.y),
+                Cell::Num(m.tool.tip.z),
+                Cell::Num(m.axis.x),
+                Cell::Num(m.axis.y),
+                Cell::Num(m.axis.z),
+                Cell::Angle(m.tool.phi1),
+                Cell::Angle(m.tool.phi2),
+            ];
+            (values, m.config, m.verdict)
+        })
+    }
+}
