@@ -4,7 +4,7 @@
 use std::fmt;
 
 use crate::machine::Machine;
-use crate::module_geometry::{ModulePose, Sliders, rod_tilts};
+use crate::module_geometry::{ModulePose, Sliders, rod_vectors};
 use crate::tolerance::{CONFIG_SIGN_MM, LIMIT_SLACK};
 
 /// Configuration indices (s1, s2, s3), each -1 or +1: the signs of rho1 - zp,
@@ -148,8 +148,12 @@ pub fn module_verdict(m: &Machine, pose: &ModulePose, rho: &Sliders, config: Con
     if g.r_big1 * pose.alpha.cos() <= g.r_small1 {
         v.add(Reason::RodsCross);
     }
-    let tilt_max = m.limits.rod_tilt_max + LIMIT_SLACK;
-    if rod_tilts(g, pose, rho).iter().any(|&t| t > tilt_max) {
+    // tilt = acos(v_z / |v|) > tilt_max  <=>  v_z < cos(tilt_max) |v| (no acos per rod).
+    let cos_max = (m.limits.rod_tilt_max + LIMIT_SLACK).cos();
+    if rod_vectors(g, pose, rho)
+        .iter()
+        .any(|r| r.z < cos_max * r.norm())
+    {
         v.add(Reason::RodTilt);
     }
     v

@@ -35,6 +35,10 @@ use crate::poly::roots_in;
 use crate::tolerance::{ACCEPT_RESIDUAL_MM, FK_DET_REL, SAME_SOLUTION_MM, SAME_SOLUTION_RAD};
 use crate::trig::Trig;
 
+/// Where Det = 0 (condition (21)), the fixed-angle sphere intersection is tried only when
+/// |b| there is below this fraction of its coefficients (a solution needs b = 0).
+const DET_ZERO_B_REL: f64 = 1e-6;
+
 /// Most assembly modes returned (the degree-8 polynomial, plus degenerate doubled solutions).
 pub const MAX_FK_MODES: usize = 16;
 
@@ -261,7 +265,12 @@ pub fn solve(m: &Machine, rho: &Sliders) -> FkModes {
     // alpha = 0, y_p = 0). Those (at most two) angles are tried directly on the four spheres,
     // keeping only points that already solve them (elsewhere Newton could wander from these
     // least-squares points and stop, unconverged, next to a solution found above).
+    let b_scale = elim.b.cos[0].abs() + elim.b.sin[1].abs();
     for alpha in det_zeros(&elim.det) {
+        // F = 4 b^2 (Q^2 + delta^2 N) > 0 there unless b = 0: no solution at this alpha.
+        if elim.b.eval(alpha).abs() > DET_ZERO_B_REL * b_scale {
+            continue;
+        }
         let on_spheres = fixed_alpha_points(g, rho, alpha)
             .into_iter()
             .filter(|p| residual_mm(g, p, rho) <= ACCEPT_RESIDUAL_MM);

@@ -113,11 +113,15 @@ pub fn rod_tilts(g: &ModuleGeometry, pose: &ModulePose, rho: &Sliders) -> [f64; 
 /// polished pose when it did not make the residual worse.
 pub fn polish_pose(g: &ModuleGeometry, start: ModulePose, rho: &Sliders) -> ModulePose {
     use crate::tolerance::{NEWTON_MAX_ITER, NEWTON_STEP_STOP};
-    let mut best = start;
-    let mut best_res = residual_mm(g, &start, rho);
+    let l = rod_lengths(g);
+    let as_mm = |f: &Vector4<f64>| (0..4).fold(0.0f64, |m, i| m.max((f[i] / (2.0 * l[i])).abs()));
     let mut cur = start;
+    let mut f = residuals(g, &cur, rho);
+    let mut best = (cur, as_mm(&f));
     for _ in 0..NEWTON_MAX_ITER {
-        let f = residuals(g, &cur, rho);
+        if as_mm(&f) == 0.0 {
+            break;
+        }
         let a = jacobian_pose(g, &cur, rho);
         let Some(step) = a.lu().solve(&f) else { break };
         if !step.iter().all(|v| v.is_finite()) {
@@ -127,16 +131,16 @@ pub fn polish_pose(g: &ModuleGeometry, start: ModulePose, rho: &Sliders) -> Modu
             p: cur.p - Vector3::new(step[0], step[1], step[2]),
             alpha: cur.alpha - step[3],
         };
-        let res = residual_mm(g, &cur, rho);
-        if res <= best_res {
-            best = cur;
-            best_res = res;
+        f = residuals(g, &cur, rho);
+        let res = as_mm(&f);
+        if res <= best.1 {
+            best = (cur, res);
         }
         if step.amax() < NEWTON_STEP_STOP * (1.0 + cur.p.amax()) {
             break;
         }
     }
-    best
+    best.0
 }
 
 #[cfg(test)]

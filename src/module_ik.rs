@@ -120,21 +120,23 @@ fn polish_leg1(g: &ModuleGeometry, p: &Vector3<f64>, start: Leg1) -> Leg1 {
     let u = p.x + g.dx1;
     let y = p.y;
     let k0 = g.l1 * g.l1 - r * r - rr * rr;
-    let resid = |l: &Leg1| {
+    // Residuals at (alpha, rho1) and what the Jacobian needs, from one sin_cos.
+    let eval = |l: &Leg1| {
         let (s, c) = l.alpha.sin_cos();
         let dz = p.z - l.rho1;
-        Vector2::new(
+        let f = Vector2::new(
             u * u + y * y + dz * dz - k0 - 2.0 * r * rr * c,
             y * (r * c - rr) + r * s * dz,
-        )
+        );
+        (f, s, c, dz)
     };
-    let mut best = start;
-    let mut best_f = resid(&start).amax();
     let mut cur = start;
+    let (mut f, mut s, mut c, mut dz) = eval(&cur);
+    let mut best = (cur, f.amax());
     for _ in 0..NEWTON_MAX_ITER {
-        let (s, c) = cur.alpha.sin_cos();
-        let dz = p.z - cur.rho1;
-        let f = resid(&cur);
+        if f.amax() == 0.0 {
+            break;
+        }
         let j = Matrix2::new(2.0 * r * rr * s, -2.0 * dz, -y * r * s + r * c * dz, -r * s);
         let Some(step) = j.try_inverse().map(|inv| inv * f) else {
             break;
@@ -146,10 +148,9 @@ fn polish_leg1(g: &ModuleGeometry, p: &Vector3<f64>, start: Leg1) -> Leg1 {
             alpha: cur.alpha - step.x,
             rho1: cur.rho1 - step.y,
         };
-        let fa = resid(&cur).amax();
-        if fa <= best_f {
-            best = cur;
-            best_f = fa;
+        (f, s, c, dz) = eval(&cur);
+        if f.amax() <= best.1 {
+            best = (cur, f.amax());
         }
         if step.x.abs() < NEWTON_STEP_STOP
             && step.y.abs() < NEWTON_STEP_STOP * (1.0 + cur.rho1.abs())
@@ -157,8 +158,9 @@ fn polish_leg1(g: &ModuleGeometry, p: &Vector3<f64>, start: Leg1) -> Leg1 {
             break;
         }
     }
-    best.alpha = wrap_angle(best.alpha);
-    best
+    let mut out = best.0;
+    out.alpha = wrap_angle(out.alpha);
+    out
 }
 
 /// Angle in (-pi, pi].

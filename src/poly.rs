@@ -39,10 +39,6 @@ pub fn eval_with_error(c: &[f64], x: f64) -> (f64, f64) {
     (p, bound * 4.0 * f64::EPSILON * c.len() as f64)
 }
 
-#[inline]
-fn eval(c: &[f64], x: f64) -> f64 {
-    c.iter().rev().fold(0.0, |p, &a| p * x + a)
-}
 
 #[inline]
 fn eval_d(c: &[f64], x: f64) -> (f64, f64) {
@@ -89,6 +85,10 @@ pub fn roots_in(c: &[f64], lo: f64, hi: f64) -> Roots {
     }
     let d = derivative(c);
     let crit = roots_in(&d, lo, hi);
+    // Refine each root to full precision: the caller's Newton polish on the original equations
+    // starts from it, and close pairs of roots must stay apart (an early stop at the rounding
+    // level of p lost a mode 1e-5 rad from its twin).
+    let noise = 0.0;
     let mut a = lo;
     let (mut fa, mut ea) = eval_with_error(c, a);
     if fa.abs() <= ea {
@@ -103,7 +103,7 @@ pub fn roots_in(c: &[f64], lo: f64, hi: f64) -> Roots {
         let a_zero = fa.abs() <= ea;
         let b_zero = fb.abs() <= eb;
         if !a_zero && !b_zero && (fa < 0.0) != (fb < 0.0) {
-            push_unique(&mut out, bracketed(c, a, b, fa));
+            push_unique(&mut out, bracketed(c, a, b, fa, noise));
         } else if b_zero {
             // b is a root (an end point, or a critical point touching zero).
             let touching = k < crit.len();
@@ -129,13 +129,16 @@ fn push_unique(out: &mut Roots, r: Root) {
 }
 
 /// The single root of a polynomial that is monotone on [a, b] with a sign change there:
-/// Newton steps kept inside a shrinking bracket, bisection when a step leaves it.
-fn bracketed(c: &[f64], mut a: f64, mut b: f64, fa: f64) -> Root {
+/// Newton steps kept inside a shrinking bracket, started from its midpoint, falling back to
+/// bisection when a step leaves the bracket. Stops once |p| is below `noise` (the rounding error
+/// of evaluating p on the interval: further steps would only follow rounding) or the bracket
+/// cannot shrink.
+fn bracketed(c: &[f64], mut a: f64, mut b: f64, fa: f64, noise: f64) -> Root {
     let a_neg = fa < 0.0;
     let mut x = 0.5 * (a + b);
     for _ in 0..200 {
         let (f, df) = eval_d(c, x);
-        if f == 0.0 {
+        if f.abs() <= noise {
             break;
         }
         if (f < 0.0) == a_neg {
@@ -157,7 +160,6 @@ fn bracketed(c: &[f64], mut a: f64, mut b: f64, fa: f64) -> Root {
         }
         x = next;
     }
-    let _ = eval(c, x);
     Root { x, touching: false }
 }
 
