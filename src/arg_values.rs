@@ -130,6 +130,21 @@ pub fn parse_machine_joints(s: &str) -> Result<[f64; 5], String> {
     parse_numbers::<5>(s, "RHO1,RHO2,RHO3,THETA1,THETA2")
 }
 
+/// Parses a `verne verify` threshold `NAME=VALUE` (names and checks in `verify::THRESHOLDS`;
+/// fractions like `1/3` allowed).
+pub fn parse_threshold(s: &str) -> Result<(String, f64), String> {
+    let Some((name, value)) = s.split_once('=') else {
+        return Err(format!(
+            "expected NAME=VALUE like tip_error_mm=0.01, found `{}`",
+            crate::table::shown(s.as_bytes())
+        ));
+    };
+    let name = name.trim();
+    let value = parse_ratio(value)?;
+    crate::verify::check_threshold_value(name, value)?;
+    Ok((name.to_string(), value))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -140,5 +155,25 @@ mod tests {
         assert!(parse_triple("1,2").unwrap_err().contains("three"));
         assert!(parse_triple("1,x,3").unwrap_err().contains("value 2"));
         assert!(parse_triple("1,inf,3").unwrap_err().contains("finite"));
+    }
+
+    #[test]
+    fn thresholds_parse_or_explain() {
+        assert_eq!(
+            parse_threshold("tip_error_mm=0.01"),
+            Ok(("tip_error_mm".to_string(), 0.01))
+        );
+        assert_eq!(parse_threshold("lambda_min = 1/4").unwrap().1, 0.25);
+        assert!(
+            parse_threshold("tip_error_mm")
+                .unwrap_err()
+                .contains("NAME=VALUE")
+        );
+        assert!(parse_threshold("nope=1").unwrap_err().contains("unknown"));
+        assert!(
+            parse_threshold("chord_error_mm=-1")
+                .unwrap_err()
+                .contains("positive")
+        );
     }
 }

@@ -4,7 +4,7 @@
 use std::fmt;
 
 use crate::machine::Machine;
-use crate::module_geometry::{ModulePose, Sliders, rod_vectors};
+use crate::module_geometry::{ModulePose, Sliders};
 use crate::tolerance::{CONFIG_SIGN_MM, LIMIT_SLACK};
 
 /// Configuration indices (s1, s2, s3), each -1 or +1: the signs of rho1 - zp,
@@ -125,36 +125,107 @@ impl fmt::Display for Verdict {
     }
 }
 
-/// The verdict of a parallel-module branch: configuration, rod crossing (section V), slider
-/// strokes and rod tilts from the machine file.
-pub fn module_verdict(m: &Machine, pose: &ModulePose, rho: &Sliders, config: Config) -> Verdict {
+/// What one leg contributes to a branch's label and verdict: its configuration index s_i
+/// (eqs. (11)-(13)) and its reasons (inverted, stroke, rod tilt). `cos_tilt_max` is
+/// cos(rod_tilt_max + slack): a rod is too tilted when v_z < cos_tilt_max |v|, which avoids an
+/// acos per rod. (s, c) = sin, cos of alpha.
+#[inline]
+pub fn leg_check(
+    m: &Machine,
+    leg: usize,
+    p: &nalgebra::Vector3<f64>,
+    s: f64,
+    c: f64,
+    rho_i: f64,
+    cos_tilt_max: f64,
+) -> (i8, Verdict) {
     let g = &m.module;
     let mut v = Verdict::default();
-    let inverted = [
-        Reason::Leg1Inverted,
-        Reason::Leg2Inverted,
-        Reason::Leg3Inverted,
-    ];
-    let stroke = [Reason::Rho1Stroke, Reason::Rho2Stroke, Reason::Rho3Stroke];
-    for i in 0..3 {
-        if config[i] != -1 {
-            v.add(inverted[i]);
+    let too_tilted = |r: nalgebra::Vector3<f64>| r.z < cos_tilt_max * r.norm();
+    let (q, tilted) = match leg {
+        0 => {
+            let (dy, dz) = (g.r_big1 * c - g.r_small1, g.r_big1 * s);
+            let u = p.x + g.dx1;
+            let r3 = nalgebra::Vector3::new(u, p.y + dy, p.z + dz - rho_i);
+            let r4 = nalgebra::Vector3::new(u, p.y - dy, p.z - dz - rho_i);
+            (rho_i - p.z, too_tilted(r3) || too_tilted(r4))
         }
-        if rho[i] < m.limits.rho_min[i] - LIMIT_SLACK || rho[i] > m.limits.rho_max[i] + LIMIT_SLACK
-        {
-            v.add(stroke[i]);
+        1 => {
+            let r5 = nalgebra::Vector3::new(
+                p.x + g.dx2,
+                p.y - g.r_big2 * c + g.r4,
+                p.z - g.r_big2 * s - rho_i,
+            );
+            (rho_i - p.z + g.r_big2 * s, too_tilted(r5))
         }
+        _ => {
+            let r6 = nalgebra::Vector3::new(
+                p.x + g.dx2,
+                p.y + g.r_big2 * c - g.r4,
+                p.z + g.r_big2 * s - rho_i,
+            );
+            (rho_i - p.z - g.r_big2 * s, too_tilted(r6))
+        }
+    };
+    let sign = if q > CONFIG_SIGN_MM { 1 } else { -1 };
+    if sign != -1 {
+        v.add(
+            [
+                Reason::Leg1Inverted,
+                Reason::Leg2Inverted,
+                Reason::Leg3Inverted,
+            ][leg],
+        );
     }
-    if g.r_big1 * pose.alpha.cos() <= g.r_small1 {
-        v.add(Reason::RodsCross);
+    if rho_i < m.limits.rho_min[leg] - LIMIT_SLACK || rho_i > m.limits.rho_max[leg] + LIMIT_SLACK {
+        v.add([Reason::Rho1Stroke, Reason::Rho2Stroke, Reason::Rho3Stroke][leg]);
     }
-    // tilt = acos(v_z / |v|) > tilt_max  <=>  v_z < cos(tilt_max) |v| (no acos per rod).
-    let cos_max = (m.limits.rod_tilt_max + LIMIT_SLACK).cos();
-    if rod_vectors(g, pose, rho)
-        .iter()
-        .any(|r| r.z < cos_max * r.norm())
-    {
+    if tilted {
         v.add(Reason::RodTilt);
     }
+    (sign, v)
+}
+
+/// cos of the largest rod tilt with its slack, for [`leg_check`].
+pub fn cos_tilt_max(m: &Machine) -> f64 {
+    (m.limits.rod_tilt_max + LIMIT_SLACK).cos()
+}
+
+/// The reasons of a whole branch: its legs' and R1 cos(alpha) <= r1 (rods of leg I cross).
+#[inline]
+pub fn combine(m: &Machine, c: f64, legs: [Verdict; 3]) -> Verdict {
+    let mut v = Verdict(legs[0].0 | legs[1].0 | legs[2].0);
+    if m.module.r_big1 * c <= m.module.r_small1 {
+        v.add(Reason::RodsCross);
+    }
     v
+}
+
+/// The verdict of a parallel-module branch: configuration, rod crossing (section V), slider
+/// strokes and rod tilts from the machine file. `config` is as given by [`config_of`].
+pub fn module_verdict(m: &Machine, pose: &ModulePose, rho: &Sliders, config: Config) -> Verdict {
+    let (s, c) = pose.alpha.sin_cos();
+    let ct = cos_tilt_max(m);
+    let legs: [Verdict; 3] = std::array::from_fn(|i| {
+        let (_, mut v) = leg_check(m, i, &pose.p, s, c, rho[i], ct);
+        // The configuration given wins over the recomputed sign (they agree up to rounding).
+        for r in [
+            Reason::Leg1Inverted,
+            Reason::Leg2Inverted,
+            Reason::Leg3Inverted,
+        ] {
+            v.0 &= !r.bit();
+        }
+        if config[i] != -1 {
+            v.add(
+                [
+                    Reason::Leg1Inverted,
+                    Reason::Leg2Inverted,
+                    Reason::Leg3Inverted,
+                ][i],
+            );
+        }
+        v
+    });
+    combine(m, c, legs)
 }

@@ -55,6 +55,11 @@ pub enum Command {
         after_help = "Example:\n  verne selftest -m my_machine.toml --grid 16\n\nExit codes: 0 every round trip returned, 1 some did not, 2 fatal."
     )]
     Selftest(SelftestArgs),
+    /// Check a postprocessor's joint table against the intended tool path: tip and axis errors,
+    /// limits (also mid-segment), chordal error, branch flips, singularity proximity, joint jumps,
+    /// speeds and accelerations. One report row per violation.
+    #[command(after_help = verne::verify::help_text())]
+    Verify(VerifyArgs),
     /// Print a shell completion script.
     #[command(
         after_help = "Example:\n  verne completions bash > ~/.local/share/bash-completion/completions/verne"
@@ -277,6 +282,44 @@ pub struct DesignArgs {
     /// CSV for a script (one row per quantity) instead of aligned tables.
     #[arg(long)]
     pub csv: bool,
+}
+
+/// How `verne verify` prints its summary.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum VerifyFormat {
+    /// Aligned text on stderr.
+    Text,
+    /// One JSON object on stdout (the text summary still goes to stderr).
+    Json,
+}
+
+#[derive(Debug, Args)]
+pub struct VerifyArgs {
+    /// Joint table (CSV): rho1,rho2,rho3 (mm), theta1,theta2 (degrees); optional id, t (s) or
+    /// feed (mm/min).
+    #[arg(long, value_name = "POST.csv")]
+    pub joints: PathBuf,
+    /// Intended path: CSV with x,y,z and i,j,k or phi1,phi2 (degrees), optional id; or an APT CL
+    /// file (.cl, .apt, .cls).
+    #[arg(long, value_name = "INTENDED.csv|cl")]
+    pub path: PathBuf,
+    /// Machine file (TOML, or CSV with a `key,value` header); its [verify] table sets thresholds.
+    /// Default: the embedded VERNE machine.
+    #[arg(short = 'm', long = "machine", value_name = "FILE")]
+    pub machine: Option<PathBuf>,
+    /// Report CSV, one row per violation: row,check,value,limit,detail (written atomically).
+    #[arg(long, value_name = "REPORT.csv")]
+    pub report: Option<PathBuf>,
+    /// Summary format.
+    #[arg(long, value_enum, default_value = "text")]
+    pub format: VerifyFormat,
+    /// Tool length (mm). Default: the machine file's.
+    #[arg(long = "tool-length", value_name = "MM", value_parser = verne::arg_values::parse_positive)]
+    pub tool_length: Option<f64>,
+    /// A threshold NAME=VALUE (repeatable; overrides the machine file's [verify] table). Names
+    /// and defaults are listed below.
+    #[arg(long, value_name = "NAME=VALUE", value_parser = verne::arg_values::parse_threshold)]
+    pub threshold: Vec<(String, f64)>,
 }
 
 #[cfg(test)]

@@ -63,5 +63,6 @@ pub fn arg_values(data: &[u8]) {
         let _ = parse_lambda_bounds(text);
         let _ = parse_tool_pose(text);
         let _ = parse_machine_joints(text);
+        let _ = parse_threshold(text);
     }
 }

@@ -25,4 +25,5 @@ pub mod selftest;
 pub mod table;
 pub mod tolerance;
 pub mod trig;
+pub mod verify;
 pub mod workspace;

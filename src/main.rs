@@ -36,6 +36,7 @@ fn main() -> ExitCode {
         cli::Command::Machine(c) => cmd::machine::run(c),
         cli::Command::Workspace(a) => cmd::workspace::run(a),
         cli::Command::Selftest(a) => cmd::selftest::run(a),
+        cli::Command::Verify(a) => cmd::verify::run(a),
         cli::Command::Completions { shell } => cmd::shell::completions(*shell),
         cli::Command::Manpage => cmd::shell::manpage(),
     };

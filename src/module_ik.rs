@@ -7,9 +7,9 @@
 use arrayvec::ArrayVec;
 use nalgebra::{Matrix2, Vector2, Vector3};
 
-use crate::branches::{Config, Verdict, config_of, module_verdict};
+use crate::branches::{Config, Verdict, combine, cos_tilt_max, leg_check};
 use crate::machine::{Machine, ModuleGeometry};
-use crate::module_geometry::{ModulePose, Sliders};
+use crate::module_geometry::Sliders;
 use crate::poly::roots_in;
 use crate::tolerance::{
     NEWTON_MAX_ITER, NEWTON_STEP_STOP, SAME_SOLUTION_RAD, SIN_ALPHA_ZERO, SQRT_ARG_REL,
@@ -190,13 +190,30 @@ fn leg_sliders(l: f64, dx: f64, dy: f64, offset: f64) -> Option<[f64; 2]> {
 /// Every real inverse-kinematics branch of the parallel module for point `p`, ordered by alpha
 /// then by (s1, s2, s3), each with its configuration and verdict. Empty when unreachable.
 pub fn solve(m: &Machine, p: &Vector3<f64>) -> IkBranches {
-    let g = &m.module;
     let mut out = IkBranches::new();
+    solve_into(m, p, &mut out);
+    out
+}
+
+/// [`solve`] into an existing list (cleared first), so a caller that keeps one avoids copying it.
+pub fn solve_into(m: &Machine, p: &Vector3<f64>, out: &mut IkBranches) {
+    let g = &m.module;
+    out.clear();
     if !p.iter().all(|v| v.is_finite()) {
-        return out;
+        return;
     }
-    for leg1 in leg1_postures(g, p) {
-        let (s, c) = leg1.alpha.sin_cos();
+    let cos_tilt = cos_tilt_max(m);
+    // Branches come out ordered by alpha, then (s1, s2, s3): postures sorted by (alpha, s1), and
+    // within a posture s2, s3 = -1 before +1 (the roots of (12)-(13) in increasing order).
+    let mut postures: ArrayVec<(Leg1, f64, f64, (i8, Verdict)), 6> = leg1_postures(g, p)
+        .into_iter()
+        .map(|l| {
+            let (s, c) = l.alpha.sin_cos();
+            (l, s, c, leg_check(m, 0, p, s, c, l.rho1, cos_tilt))
+        })
+        .collect();
+    postures.sort_unstable_by(|a, b| a.0.alpha.total_cmp(&b.0.alpha).then(a.3.0.cmp(&b.3.0)));
+    for (leg1, s, c, l1) in postures {
         let dx2 = p.x + g.dx2;
         // eq. (12): rho2 = zp - R2 sin a + s2 sqrt(L2^2 - (xp + D2 - d2)^2 - (yp - R2 cos a + r4)^2)
         let Some(r2) = leg_sliders(g.l2, dx2, p.y - g.r_big2 * c + g.r4, p.z - g.r_big2 * s) else {
@@ -206,26 +223,21 @@ pub fn solve(m: &Machine, p: &Vector3<f64>) -> IkBranches {
         let Some(r3) = leg_sliders(g.l3, dx2, p.y + g.r_big2 * c - g.r4, p.z + g.r_big2 * s) else {
             continue;
         };
-        let pose = ModulePose {
-            p: *p,
-            alpha: leg1.alpha,
-        };
-        for rho2 in r2 {
-            for rho3 in r3 {
-                let rho = Sliders::new(leg1.rho1, rho2, rho3);
-                let config = config_of(g, &pose, &rho);
-                let verdict = module_verdict(m, &pose, &rho, config);
+        // Labels and verdicts leg by leg: leg I once per posture, legs II and III once per root.
+        let leg = |i: usize, rho_i: f64| leg_check(m, i, p, s, c, rho_i, cos_tilt);
+        let l2 = [leg(1, r2[0]), leg(1, r2[1])];
+        let l3 = [leg(2, r3[0]), leg(2, r3[1])];
+        for (k2, rho2) in r2.into_iter().enumerate() {
+            for (k3, rho3) in r3.into_iter().enumerate() {
                 out.push(IkBranch {
                     alpha: leg1.alpha,
-                    rho,
-                    config,
-                    verdict,
+                    rho: Sliders::new(leg1.rho1, rho2, rho3),
+                    config: [l1.0, l2[k2].0, l3[k3].0],
+                    verdict: combine(m, c, [l1.1, l2[k2].1, l3[k3].1]),
                 });
             }
         }
     }
-    out.sort_by(|a, b| a.alpha.total_cmp(&b.alpha).then(a.config.cmp(&b.config)));
-    out
 }
 
 /// The machine's branch: the unique feasible one, or (if several are feasible, which the default

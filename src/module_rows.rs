@@ -35,9 +35,10 @@ impl RowJob for ModuleIk {
     }
 
     fn solve(&self, inputs: &[f64], solved: &mut IkBranches) {
-        *solved = module_ik::solve(
+        module_ik::solve_into(
             &self.machine,
             &Vector3::new(inputs[0], inputs[1], inputs[2]),
+            solved,
         );
     }
 

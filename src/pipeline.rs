@@ -231,19 +231,21 @@ pub fn run<J: RowJob>(
     let mut record = ByteRecord::new();
     let mut scratch = Vec::with_capacity(64);
     let mut out_cells = vec![Cell::Empty; outputs.len()];
-    let mut spare: Vec<PendingRow<J::Solved>> = Vec::new();
     loop {
-        // Fill a batch.
-        batch.clear();
-        while batch.len() < BATCH_ROWS {
-            let mut row = spare.pop().unwrap_or_else(|| PendingRow {
-                record: ByteRecord::new(),
-                values: [0.0; MAX_INPUTS],
-                invalid: None,
-                solved: J::Solved::default(),
-            });
+        // Fill a batch, reusing its rows in place (a row holds a solver's fixed-capacity result,
+        // a kilobyte or more: moving rows would cost more than solving them).
+        let mut filled = 0;
+        while filled < BATCH_ROWS {
+            if filled == batch.len() {
+                batch.push(PendingRow {
+                    record: ByteRecord::new(),
+                    values: [0.0; MAX_INPUTS],
+                    invalid: None,
+                    solved: J::Solved::default(),
+                });
+            }
+            let row = &mut batch[filled];
             if !source.read(&mut row.record)? {
-                spare.push(row);
                 break;
             }
             row.invalid = None;
@@ -285,21 +287,24 @@ pub fn run<J: RowJob>(
                     }
                 }
             }
-            batch.push(row);
+            filled += 1;
         }
-        if batch.is_empty() {
+        if filled == 0 {
             break;
         }
         // Solve in parallel.
         let n_in = inputs.len();
         let job_ref: &J = job;
-        batch.par_iter_mut().with_min_len(64).for_each(|row| {
-            if row.invalid.is_none() {
-                job_ref.solve(&row.values[..n_in], &mut row.solved);
-            }
-        });
+        batch[..filled]
+            .par_iter_mut()
+            .with_min_len(64)
+            .for_each(|row| {
+                if row.invalid.is_none() {
+                    job_ref.solve(&row.values[..n_in], &mut row.solved);
+                }
+            });
         // Emit in order.
-        for row in batch.drain(..) {
+        for row in &batch[..filled] {
             summary.input_rows += 1;
             let line = row.record.position().map(|p| p.line()).unwrap_or(0);
             let mut writer = RowWriter {
@@ -342,7 +347,6 @@ pub fn run<J: RowJob>(
                 }
                 summary.count(&text, line);
             }
-            spare.push(row);
         }
         progress(summary.input_rows);
     }

@@ -39,7 +39,6 @@ pub fn eval_with_error(c: &[f64], x: f64) -> (f64, f64) {
     (p, bound * 4.0 * f64::EPSILON * c.len() as f64)
 }
 
-
 #[inline]
 fn eval_d(c: &[f64], x: f64) -> (f64, f64) {
     let mut p = 0.0;

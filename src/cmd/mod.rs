@@ -9,6 +9,7 @@ pub mod machine;
 pub mod modes;
 pub mod selftest;
 pub mod shell;
+pub mod verify;
 pub mod workspace;
 
 use std::io::IsTerminal;
