@@ -160,6 +160,9 @@ pub struct ModesArgs {
     /// CSV for a script instead of an aligned table.
     #[arg(long)]
     pub csv: bool,
+    /// Also draw every branch (sliders, rods, platform; front view) to FILE.svg or FILE.png.
+    #[arg(long, value_name = "FILE.svg|png")]
+    pub plot: Option<PathBuf>,
     #[command(flatten)]
     pub common: CommonArgs,
 }

@@ -288,3 +288,67 @@ fn modes_prints_an_aligned_table() {
         "{text}"
     );
 }
+
+#[test]
+fn committed_man_page_matches_the_cli() {
+    let out = run(&["manpage"], None);
+    assert_eq!(out.status.code(), Some(0));
+    let committed =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/verne.1")).unwrap();
+    assert!(
+        String::from_utf8(out.stdout).unwrap() == committed,
+        "docs/verne.1 is stale: regenerate it with `cargo run -- manpage > docs/verne.1`"
+    );
+}
+
+#[test]
+fn every_subcommand_help_has_an_example() {
+    for sub in [
+        "ik",
+        "fk",
+        "modes",
+        "workspace",
+        "verify",
+        "design",
+        "selftest",
+        "completions",
+    ] {
+        let out = run(&[sub, "--help"], None);
+        assert_eq!(out.status.code(), Some(0), "{sub}");
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            text.contains("verne "),
+            "{sub} --help has no example:\n{text}"
+        );
+        assert!(
+            text.contains("Example"),
+            "{sub} --help has no example:\n{text}"
+        );
+    }
+    let v = run(&["--version"], None);
+    assert!(String::from_utf8_lossy(&v.stdout).starts_with("verne "));
+}
+
+#[test]
+fn modes_plot_draws_every_branch() {
+    let dir = std::env::temp_dir().join(format!("verne-cli-plot-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let f = dir.join("b.svg");
+    let out = run(
+        &[
+            "modes",
+            "--joints",
+            "674,685,250",
+            "--plot",
+            f.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert_eq!(out.status.code(), Some(0));
+    let svg = std::fs::read_to_string(&f).unwrap();
+    assert!(svg.contains("<svg"));
+    for k in 1..=4 {
+        assert!(svg.contains(&format!("{k}: s=(")), "panel {k} missing");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -10,6 +10,7 @@ use verne::module_fk;
 use verne::module_geometry::{ModulePose, Sliders};
 use verne::module_ik;
 use verne::pipeline::{Cell, Units, write_cell};
+use verne::plot::{BranchSketch, branches_picture};
 
 use super::{EXIT_OK, EXIT_ROWS_FAILED, load_machine, units, write_stdout};
 use crate::cli::ModesArgs;
@@ -60,6 +61,27 @@ pub fn run(args: &ModesArgs) -> Result<u8, VerneError> {
         .map(|r| r.iter().map(|c| cell_text(*c, u, args.csv)).collect())
         .collect();
     write_stdout(&render(&title, &header, &text_rows, args.csv))?;
+    if let Some(path) = &args.plot {
+        let sketches: Vec<BranchSketch> = solutions
+            .iter()
+            .enumerate()
+            .map(|(k, s)| BranchSketch {
+                pose: s.pose,
+                rho: s.rho,
+                label: format!(
+                    "{}: s=({},{},{})",
+                    k + 1,
+                    s.config[0],
+                    s.config[1],
+                    s.config[2]
+                ),
+                detail: s.verdict.to_string(),
+                working: s.verdict.feasible(),
+            })
+            .collect();
+        branches_picture(path, &machine, &title, &sketches)
+            .map_err(|e| VerneError::io(&path.display().to_string(), std::io::Error::other(e)))?;
+    }
     Ok(if rows.is_empty() {
         EXIT_ROWS_FAILED
     } else {
