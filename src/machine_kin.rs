@@ -35,14 +35,14 @@ use nalgebra::{Matrix2, Matrix4, Vector2, Vector3, Vector4};
 use crate::branches::{Config, Reason, Verdict, config_of, module_verdict};
 use crate::machine::{Machine, TableGeometry};
 use crate::module_geometry::{ModulePose, Sliders, residual_mm};
-use crate::module_ik::wrap_angle;
+use crate::module_ik::{leg_sliders, wrap_angle};
 use crate::orientation::{
     AxisAngles, AxisError, ToolAngles, ToolOrientation, axis_angles, phi1_at, unit_axis,
 };
 use crate::poly::roots_in;
 use crate::tolerance::{
     ACCEPT_RESIDUAL_MM, LIMIT_SLACK, NEWTON_MAX_ITER, NEWTON_STEP_STOP, SAME_SOLUTION_MM,
-    SAME_SOLUTION_RAD, SQRT_ARG_REL,
+    SAME_SOLUTION_RAD,
 };
 use crate::trig::Trig;
 
@@ -319,16 +319,6 @@ impl Leg1Path<'_> {
         }
         (wrap_angle(best.0), best.1)
     }
-}
-
-/// Both roots `offset -/+ sqrt(L^2 - dx^2 - dy^2)` of eq. (12) or (13), or None when not real.
-fn leg_sliders(l: f64, dx: f64, dy: f64, offset: f64) -> Option<[f64; 2]> {
-    let arg = l * l - dx * dx - dy * dy;
-    if arg < -SQRT_ARG_REL * l * l || !arg.is_finite() {
-        return None;
-    }
-    let h = arg.max(0.0).sqrt();
-    Some([offset - h, offset + h])
 }
 
 fn theta1_in_limits(m: &Machine, theta1: f64) -> bool {

@@ -178,7 +178,7 @@ fn angle_diff(a: f64, b: f64) -> f64 {
 }
 
 /// Both roots of eqs. (12)-(13) for one leg: `offset + s * sqrt(L^2 - dx^2 - dy^2)`, s = -1 first.
-fn leg_sliders(l: f64, dx: f64, dy: f64, offset: f64) -> Option<[f64; 2]> {
+pub(crate) fn leg_sliders(l: f64, dx: f64, dy: f64, offset: f64) -> Option<[f64; 2]> {
     let arg = l * l - dx * dx - dy * dy;
     if arg < -SQRT_ARG_REL * l * l || !arg.is_finite() {
         return None;

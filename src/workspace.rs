@@ -1016,25 +1016,9 @@ pub fn largest_box(map: &OutcomeGrid, lo: [usize; 3], hi: [usize; 3]) -> Option<
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nalgebra::{Matrix4, Vector4};
-
-    fn trans(v: Vector3<f64>) -> Matrix4<f64> {
-        Matrix4::new_translation(&v)
-    }
-
-    fn rot_x(a: f64) -> Matrix4<f64> {
-        let (s, c) = a.sin_cos();
-        Matrix4::new(
-            1.0, 0.0, 0.0, 0.0, 0.0, c, -s, 0.0, 0.0, s, c, 0.0, 0.0, 0.0, 0.0, 1.0,
-        )
-    }
-
-    fn rot_z(a: f64) -> Matrix4<f64> {
-        let (s, c) = a.sin_cos();
-        Matrix4::new(
-            c, -s, 0.0, 0.0, s, c, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0,
-        )
-    }
+    use crate::machine_kin::{platform_transform, table_transform};
+    use crate::module_geometry::ModulePose;
+    use nalgebra::Vector4;
 
     #[test]
     fn eq_26_and_27_match_the_matrix_products() {
@@ -1046,17 +1030,13 @@ mod tests {
             (Vector3::new(0.0, 0.0, 800.0), 0.0, 0.0),
         ] {
             // bT_pl = trans(P) rot(x, alpha), eq. (1); tool tip (0, 0, Delta) in R_pl.
-            let b_t_pl = trans(p) * rot_x(alpha);
+            let b_t_pl = platform_transform(&ModulePose { p, alpha });
             let u = b_t_pl * Vector4::new(0.0, 0.0, delta, 1.0);
             let tip = tool_tip(&p, alpha, delta);
             assert!((u.xyz() - tip).amax() < 1e-9, "{u} vs {tip}");
             // bT_t = trans(z, d_a) rot(x, theta1) trans(z, d_t) rot(x, pi) rot(z, theta2),
             // eq. (7), with theta1 = alpha, theta2 = 0; tU = bT_t^-1 bU, eq. (25).
-            let b_t_t = trans(Vector3::new(0.0, 0.0, t.d_a))
-                * rot_x(alpha)
-                * trans(Vector3::new(0.0, 0.0, t.d_t))
-                * rot_x(PI)
-                * rot_z(0.0);
+            let b_t_t = table_transform(&t, alpha, 0.0);
             let t_u = b_t_t.try_inverse().unwrap() * u;
             let mt = manufacturing_tip(&t, &p, alpha, delta);
             assert!((t_u.xyz() - mt).amax() < 1e-9, "{t_u} vs {mt}");

@@ -18,7 +18,11 @@ fn path_csv(n: usize) -> String {
     let mut s = String::from("xp,yp,zp\n");
     for k in 0..n {
         let a = k as f64 * 1e-3;
-        s.push_str(&format!("{},{},1050\n", -250.0 + 80.0 * a.cos(), 90.0 * a.sin()));
+        s.push_str(&format!(
+            "{},{},1050\n",
+            -250.0 + 80.0 * a.cos(),
+            90.0 * a.sin()
+        ));
     }
     s
 }
@@ -51,8 +55,14 @@ fn interrupted_run_leaves_no_file_behind() {
         assert!(status.success());
         let code = child.wait().unwrap();
         drop(stdin);
-        assert!(!code.success(), "SIG{signal}: the run must not report success");
-        let left: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name()).collect();
+        assert!(
+            !code.success(),
+            "SIG{signal}: the run must not report success"
+        );
+        let left: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
         assert!(left.is_empty(), "SIG{signal} left {left:?}");
     }
     let _ = std::fs::remove_dir_all(&dir);
@@ -66,15 +76,28 @@ fn a_full_disk_is_a_clean_fatal_error() {
     let mut child = Command::new(BIN)
         .args(["ik"])
         .stdin(Stdio::piped())
-        .stdout(std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap())
+        .stdout(
+            std::fs::OpenOptions::new()
+                .write(true)
+                .open("/dev/full")
+                .unwrap(),
+        )
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    child.stdin.take().unwrap().write_all(path_csv(100).as_bytes()).unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(path_csv(100).as_bytes())
+        .unwrap();
     let out = child.wait_with_output().unwrap();
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("<stdout>") && err.contains("No space left on device"), "{err}");
+    assert!(
+        err.contains("<stdout>") && err.contains("No space left on device"),
+        "{err}"
+    );
     assert!(!err.contains("panicked"), "{err}");
 }
 
@@ -95,8 +118,17 @@ fn a_closed_pipe_ends_the_run_quietly() {
     std::io::Read::read_exact(&mut stdout, &mut first).unwrap();
     drop(stdout);
     let out = child.wait_with_output().unwrap();
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
-    assert!(out.stderr.is_empty(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        out.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -140,7 +172,11 @@ fn every_input_row_yields_one_output_row() {
         let out = child.wait_with_output().unwrap();
         writer.join().unwrap().unwrap();
         let text = String::from_utf8(out.stdout).unwrap();
-        let ids: Vec<usize> = text.lines().skip(1).map(|l| l.split(',').next().unwrap().parse().unwrap()).collect();
+        let ids: Vec<usize> = text
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').next().unwrap().parse().unwrap())
+            .collect();
         if all {
             // Branch rows of one input row are contiguous; every id appears, in order.
             let mut distinct = ids.clone();
