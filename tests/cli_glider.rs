@@ -2,10 +2,10 @@
 //! `verne design`) and compare parsed numbers within named tolerances (docs/gliders.md).
 
 use std::collections::HashMap;
-use std::io::Write;
-use std::process::{Command, Output, Stdio};
+mod common;
 
-const BIN: &str = env!("CARGO_BIN_EXE_verne");
+use common::run;
+use std::process::Output;
 
 const PRESETS: [&str; 3] = ["biglide1", "biglide2", "orthoglide"];
 
@@ -21,24 +21,6 @@ const TABLE2_REL_TOL: f64 = 0.05;
 
 /// Grid nodes of `verne design` in the tests (the default 1201 is slower, S closer).
 const DESIGN_NODES: &str = "401";
-
-fn run(args: &[&str], stdin: Option<&str>) -> Output {
-    let mut child = Command::new(BIN)
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("binary runs");
-    {
-        let mut input = child.stdin.take().unwrap();
-        if let Some(s) = stdin {
-            input.write_all(s.as_bytes()).unwrap();
-        }
-    }
-    child.wait_with_output().unwrap()
-}
 
 /// Parsed CSV output: header and rows of cells.
 struct Table {

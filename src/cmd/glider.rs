@@ -267,15 +267,8 @@ impl RowJob for GliderIk {
         if self.all {
             for (k, s) in sols.iter().enumerate() {
                 let bits = verdict(&self.spec, *p, s.rho, s.mode, s.assembly);
-                out.row(&[
-                    Cell::Int(k as i64 + 1),
-                    Cell::Str(mode_label(s.mode)),
-                    Cell::Str(branch_label(s.assembly)),
-                    Cell::Num(s.rho.x),
-                    Cell::Num(s.rho.y),
-                    Cell::Bool(bits == 0),
-                    Cell::Str(status_text(bits)),
-                ])?;
+                let labels = [mode_label(s.mode), branch_label(s.assembly)];
+                branch_row(out, k, labels, [s.rho.x, s.rho.y], bits)?;
             }
             return Ok(RowOutcome {
                 ok: true,
@@ -403,15 +396,8 @@ impl RowJob for GliderFk {
         if self.all {
             for (k, f) in sols.iter().enumerate() {
                 let bits = verdict(&self.spec, f.p, rho, f.mode, f.assembly);
-                out.row(&[
-                    Cell::Int(k as i64 + 1),
-                    Cell::Str(branch_label(f.assembly)),
-                    Cell::Str(mode_label(f.mode)),
-                    Cell::Num(f.p.x),
-                    Cell::Num(f.p.y),
-                    Cell::Bool(bits == 0),
-                    Cell::Str(status_text(bits)),
-                ])?;
+                let labels = [branch_label(f.assembly), mode_label(f.mode)];
+                branch_row(out, k, labels, [f.p.x, f.p.y], bits)?;
             }
             return Ok(RowOutcome {
                 ok: true,
@@ -1039,6 +1025,25 @@ fn workspace_svg(
     );
     s.push_str("</svg>\n");
     s
+}
+
+/// One `--all` row: `branch`, two labels, two values, `working`, `status`.
+fn branch_row(
+    out: &mut RowWriter<'_>,
+    k: usize,
+    labels: [&'static str; 2],
+    values: [f64; 2],
+    bits: u8,
+) -> Result<(), VerneError> {
+    out.row(&[
+        Cell::Int(k as i64 + 1),
+        Cell::Str(labels[0]),
+        Cell::Str(labels[1]),
+        Cell::Num(values[0]),
+        Cell::Num(values[1]),
+        Cell::Bool(bits == 0),
+        Cell::Str(status_text(bits)),
+    ])
 }
 
 #[cfg(test)]
