@@ -578,8 +578,9 @@ impl Fixture {
 
     fn run_ik_working(&self, pts: &[Vector3<f64>]) -> f64 {
         let mut acc = 0.0;
+        let mut b = module_ik::IkBranches::new();
         for p in pts {
-            let b = module_ik::solve(&self.machine, black_box(p));
+            module_ik::solve_working_into(&self.machine, black_box(p), &mut b);
             if let Some(w) = module_ik::working(&b) {
                 acc += w.rho.x;
             }

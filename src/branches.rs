@@ -141,7 +141,16 @@ pub fn leg_check(
 ) -> (i8, Verdict) {
     let g = &m.module;
     let mut v = Verdict::default();
-    let too_tilted = |r: nalgebra::Vector3<f64>| r.z < cos_tilt_max * r.norm();
+    // r.z < cos_tilt_max |r|, squared (no square root).
+    let ct2 = cos_tilt_max * cos_tilt_max;
+    let too_tilted = |r: nalgebra::Vector3<f64>| {
+        let zz = r.z * r.z;
+        if cos_tilt_max >= 0.0 {
+            r.z < 0.0 || zz < ct2 * r.norm_squared()
+        } else {
+            r.z < 0.0 && zz > ct2 * r.norm_squared()
+        }
+    };
     let (q, tilted) = match leg {
         0 => {
             let (dy, dz) = (g.r_big1 * c - g.r_small1, g.r_big1 * s);

@@ -35,11 +35,12 @@ impl RowJob for ModuleIk {
     }
 
     fn solve(&self, inputs: &[f64], solved: &mut IkBranches) {
-        module_ik::solve_into(
-            &self.machine,
-            &Vector3::new(inputs[0], inputs[1], inputs[2]),
-            solved,
-        );
+        let p = Vector3::new(inputs[0], inputs[1], inputs[2]);
+        if self.all {
+            module_ik::solve_into(&self.machine, &p, solved);
+        } else {
+            module_ik::solve_working_into(&self.machine, &p, solved);
+        }
     }
 
     fn emit(&mut self, b: &IkBranches, out: &mut RowWriter<'_>) -> Result<RowOutcome, VerneError> {

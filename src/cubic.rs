@@ -1,0 +1,172 @@
+//! Real roots of a cubic on an interval, for the inverse kinematics' eq. (9) (IFToMM 2007): the
+//! method of [`crate::poly::roots_in`] (critical points split the interval into monotone
+//! pieces; a piece with a sign change holds exactly one root) with the critical points in closed
+//! form and each root found by Newton steps kept inside its bracket, started from the secant
+//! point instead of the midpoint. Close calls (a critical point within rounding of a double root
+//! of p', a leading coefficient within rounding of zero) go to the general routine.
+
+use arrayvec::ArrayVec;
+
+use crate::poly::{Root, eval_with_error, roots_in};
+
+/// The roots on one interval: at most three, plus critical points reported as touching.
+pub type CubicRoots = ArrayVec<Root, 8>;
+
+/// All real roots of `c[0] + c[1] x + c[2] x^2 + c[3] x^3` in [lo, hi], sorted, with the
+/// semantics of [`roots_in`] (end points that are roots included, critical points where |p|
+/// is within its rounding error reported as touching).
+pub fn cubic_roots_in(c: &[f64; 4], lo: f64, hi: f64) -> CubicRoots {
+    let scale = c.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+    // p' = 3 c3 x^2 + 2 c2 x + c1: closed form unless it is (nearly) linear or (nearly) a square.
+    let (a, b, k) = (3.0 * c[3], 2.0 * c[2], c[1]);
+    let disc = b * b - 4.0 * a * k;
+    let rounding = 16.0 * f64::EPSILON * (b * b + (4.0 * a * k).abs());
+    if c[3].abs() <= 1e-8 * scale
+        || disc.abs() <= rounding
+        || !disc.is_finite()
+        || lo.partial_cmp(&hi) != Some(std::cmp::Ordering::Less)
+    {
+        return roots_in(c, lo, hi).into_iter().take(8).collect();
+    }
+    let mut crit = ArrayVec::<f64, 2>::new();
+    if disc > 0.0 {
+        let q = -0.5 * (b + b.signum() * disc.sqrt());
+        let (x1, x2) = (q / a, k / q);
+        let (x1, x2) = if x1 <= x2 { (x1, x2) } else { (x2, x1) };
+        crit.extend([x1, x2].into_iter().filter(|&x| x > lo && x < hi));
+    }
+    let mut out = CubicRoots::new();
+    let (mut xa, (mut fa, mut ea)) = (lo, eval_with_error(c, lo));
+    if fa.abs() <= ea {
+        out.push(Root {
+            x: lo,
+            touching: false,
+        });
+    }
+    for k in 0..=crit.len() {
+        let xb = if k < crit.len() { crit[k] } else { hi };
+        let (fb, eb) = eval_with_error(c, xb);
+        let b_zero = fb.abs() <= eb;
+        if fa.abs() > ea && !b_zero && (fa < 0.0) != (fb < 0.0) {
+            push(&mut out, bracketed(c, xa, xb, fa, fb));
+        } else if b_zero {
+            push(
+                &mut out,
+                Root {
+                    x: xb,
+                    touching: k < crit.len(),
+                },
+            );
+        }
+        (xa, fa, ea) = (xb, fb, eb);
+    }
+    out
+}
+
+fn push(out: &mut CubicRoots, r: Root) {
+    if let Some(last) = out.last_mut()
+        && (r.x - last.x).abs() <= 4.0 * f64::EPSILON * (1.0 + r.x.abs())
+    {
+        last.touching &= r.touching;
+        return;
+    }
+    let _ = out.try_push(r);
+}
+
+/// The root of a cubic that is monotone on [a, b] with p(a), p(b) of opposite signs: Newton
+/// from the secant point, every step kept inside the shrinking bracket (bisection otherwise),
+/// until the step or the bracket reaches rounding level.
+fn bracketed(c: &[f64; 4], mut a: f64, mut b: f64, fa: f64, fb: f64) -> Root {
+    let a_neg = fa < 0.0;
+    let mut x = a + (b - a) * (fa / (fa - fb));
+    if !(x > a && x < b) {
+        x = 0.5 * (a + b);
+    }
+    for _ in 0..200 {
+        let f = ((c[3] * x + c[2]) * x + c[1]) * x + c[0];
+        let df = (3.0 * c[3] * x + 2.0 * c[2]) * x + c[1];
+        if f == 0.0 {
+            break;
+        }
+        if (f < 0.0) == a_neg {
+            a = x;
+        } else {
+            b = x;
+        }
+        let step = f / df;
+        let newton = x - step;
+        let inside = df != 0.0 && newton > a && newton < b;
+        // A Newton step at rounding level ends it: with f at rounding level, the step may land
+        // on the bracket's own end (x itself), and bisecting from there would start over.
+        if inside && step.abs() <= 2.0 * f64::EPSILON * x.abs().max(1e-300) {
+            x = newton;
+            break;
+        }
+        if df != 0.0 && step.abs() <= 2.0 * f64::EPSILON * x.abs().max(1e-300) {
+            break;
+        }
+        x = if inside { newton } else { 0.5 * (a + b) };
+        if b - a <= f64::EPSILON * (a.abs() + b.abs()) {
+            break;
+        }
+    }
+    Root { x, touching: false }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn from_roots(rs: [f64; 3], lead: f64) -> [f64; 4] {
+        let [r1, r2, r3] = rs;
+        [
+            -lead * r1 * r2 * r3,
+            lead * (r1 * r2 + r1 * r3 + r2 * r3),
+            -lead * (r1 + r2 + r3),
+            lead,
+        ]
+    }
+
+    /// Same roots as the general routine, to rounding, on random cubics and sub-intervals.
+    #[test]
+    fn agrees_with_the_general_routine() {
+        let mut s = 1u64;
+        let mut unit = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..20_000 {
+            let rs = [2.4 * unit() - 1.2, 2.4 * unit() - 1.2, 2.4 * unit() - 1.2];
+            let c = from_roots(rs, if unit() < 0.5 { -1.0 } else { 0.3 });
+            let lo = -1.0 + 0.5 * unit();
+            let fast = cubic_roots_in(&c, lo, 1.0);
+            let slow = roots_in(&c, lo, 1.0);
+            assert_eq!(
+                fast.len(),
+                slow.len(),
+                "{rs:?} on [{lo}, 1]: {fast:?} vs {slow:?}"
+            );
+            for (f, g) in fast.iter().zip(&slow) {
+                assert!((f.x - g.x).abs() < 1e-9, "{rs:?}: {fast:?} vs {slow:?}");
+                assert_eq!(f.touching, g.touching, "{rs:?}: {fast:?} vs {slow:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn close_pair_double_root_and_end_points() {
+        let got = cubic_roots_in(&from_roots([0.1, 0.1 + 1e-5, 0.5], 1.0), -1.0, 1.0);
+        assert_eq!(got.len(), 3, "{got:?}");
+        let got = cubic_roots_in(&from_roots([0.3, 0.3, -0.7], 1.0), -1.0, 1.0);
+        assert!(
+            got.iter().any(|r| (r.x - 0.3).abs() < 1e-7 && r.touching),
+            "{got:?}"
+        );
+        assert!(got.iter().any(|r| (r.x + 0.7).abs() < 1e-12), "{got:?}");
+        let got = cubic_roots_in(&from_roots([-1.0, 2.0, 0.25], 1.0), -1.0, 1.0);
+        assert_eq!(got.len(), 2, "{got:?}");
+        assert_eq!(got[0].x, -1.0);
+    }
+}
