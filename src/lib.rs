@@ -8,6 +8,7 @@ pub mod branches;
 pub mod cubic;
 pub mod error;
 #[doc(hidden)]
+pub mod fk_track;
 pub mod fuzz_entry;
 pub mod glider;
 pub mod jacobian;

@@ -6,6 +6,7 @@ use nalgebra::Vector3;
 
 use crate::branches::{Config, Verdict};
 use crate::error::VerneError;
+use crate::fk_track::FkTracker;
 use crate::machine::Machine;
 use crate::module_fk::{self, FkModes};
 use crate::module_ik::{self, IkBranches};
@@ -149,6 +150,28 @@ impl RowJob for ModuleFk {
             &self.machine,
             &Vector3::new(inputs[0], inputs[1], inputs[2]),
         );
+    }
+
+    /// The working mode is followed from row to row within a run ([`FkTracker`]); `--all`
+    /// solves every row completely.
+    fn solve_run<'a>(&self, rows: &mut dyn Iterator<Item = (Option<&'a [f64]>, &'a mut FkModes)>)
+    where
+        FkModes: 'a,
+    {
+        if self.all {
+            for (inputs, solved) in rows {
+                if let Some(v) = inputs {
+                    self.solve(v, solved);
+                }
+            }
+            return;
+        }
+        let mut tracker = FkTracker::new(&self.machine);
+        for (inputs, solved) in rows {
+            if let Some(v) = inputs {
+                tracker.working_into(&Vector3::new(v[0], v[1], v[2]), solved);
+            }
+        }
     }
 
     fn emit(&mut self, modes: &FkModes, out: &mut RowWriter<'_>) -> Result<RowOutcome, VerneError> {

@@ -10,10 +10,13 @@ use rayon::prelude::*;
 
 use crate::branches::Verdict;
 use crate::error::VerneError;
-use crate::table::{CellError, CsvSource, Sink, format_number, parse_number, shown};
+use crate::table::{CellError, CsvSource, Sink, encode_field, format_number, parse_number, shown};
 
-/// Rows solved together; bounds memory and amortises thread hand-off.
-pub const BATCH_ROWS: usize = 4096;
+/// Input rows read together; bounds memory and amortises thread hand-off.
+pub const BATCH_ROWS: usize = 1024;
+/// Output rows a batch aims at: a job that writes several rows per input row (`--all`) reads
+/// fewer input rows per batch, so memory stays bounded whatever the input.
+const BATCH_OUTPUT_ROWS: usize = 8 * BATCH_ROWS;
 
 /// Most numeric input columns a job reads.
 pub const MAX_INPUTS: usize = 8;
@@ -56,9 +59,9 @@ pub struct RowOutcome {
 }
 
 /// A kind of row computation.
-pub trait RowJob: Sync {
+pub trait RowJob: Sync + Send {
     /// Per-row result of the parallel solve.
-    type Solved: Send + Default;
+    type Solved: Send + Sync + Default;
 
     /// Required numeric input columns, and whether each is an angle.
     fn inputs(&self) -> &[(&'static str, bool)];
@@ -68,6 +71,23 @@ pub trait RowJob: Sync {
 
     /// Solves one row (inputs in radians and mm). Runs in parallel: no shared state.
     fn solve(&self, inputs: &[f64], solved: &mut Self::Solved);
+
+    /// Solves a run of consecutive rows (at most [`RUN_ROWS`]) in input order, on one thread;
+    /// `None` marks an invalid row, left unsolved. Runs start at fixed row counts, so a job that
+    /// carries something from row to row within a run (a tracker) gives the same output whatever
+    /// the number of threads. The default solves each row on its own.
+    fn solve_run<'a>(
+        &self,
+        rows: &mut dyn Iterator<Item = (Option<&'a [f64]>, &'a mut Self::Solved)>,
+    ) where
+        Self::Solved: 'a,
+    {
+        for (inputs, solved) in rows {
+            if let Some(inputs) = inputs {
+                self.solve(inputs, solved);
+            }
+        }
+    }
 
     /// Emits the output row(s) of one solved input row, in input order. May keep state
     /// between rows (branch continuity along a path).
@@ -84,14 +104,12 @@ enum Slot {
     Computed(usize),
 }
 
-/// Writes output rows: the current input record's fields followed by (or merged with) computed
-/// cells.
+/// Collects the output rows of one input row: its computed cells, to be written after the
+/// input columns (or merged with them) when the batch is encoded.
 pub struct RowWriter<'a> {
-    plan: &'a [Slot],
-    input: &'a ByteRecord,
-    record: &'a mut ByteRecord,
-    scratch: &'a mut Vec<u8>,
-    sink: &'a mut Sink,
+    input: u32,
+    out_input: &'a mut Vec<u32>,
+    out_cells: &'a mut Vec<Cell>,
     units: Units,
     n_computed: usize,
     rows: u64,
@@ -101,19 +119,10 @@ impl RowWriter<'_> {
     /// Writes one output row with the given computed cells (one per output column).
     pub fn row(&mut self, cells: &[Cell]) -> Result<(), VerneError> {
         debug_assert_eq!(cells.len(), self.n_computed);
-        self.record.clear();
-        for slot in self.plan {
-            match *slot {
-                Slot::Input(i) => self.record.push_field(self.input.get(i).unwrap_or(b"")),
-                Slot::Computed(k) => {
-                    self.scratch.clear();
-                    write_cell(self.scratch, cells[k], self.units);
-                    self.record.push_field(self.scratch);
-                }
-            }
-        }
+        self.out_input.push(self.input);
+        self.out_cells.extend_from_slice(cells);
         self.rows += 1;
-        self.sink.write(self.record)
+        Ok(())
     }
 
     pub fn units(&self) -> Units {
@@ -174,8 +183,80 @@ impl RunSummary {
 struct PendingRow<S> {
     record: ByteRecord,
     values: [f64; MAX_INPUTS],
+    /// The first input column that is empty or not finite (the row is `invalid_input`).
     invalid: Option<usize>,
+    /// The first input column that is not a number at all (a fatal error).
+    not_a_number: Option<usize>,
     solved: S,
+}
+
+/// Rows in flight: read, being solved, or being written. Reused from batch to batch.
+struct Batch<S> {
+    rows: Vec<PendingRow<S>>,
+    filled: usize,
+    /// For each output row, the input row it belongs to; its computed cells follow in order.
+    out_input: Vec<u32>,
+    out_cells: Vec<Cell>,
+    /// The encoded output, one buffer per run of output rows.
+    encoded: Vec<Vec<u8>>,
+    encoded_runs: usize,
+}
+
+impl<S: Default> Batch<S> {
+    fn new() -> Batch<S> {
+        Batch {
+            rows: Vec::with_capacity(BATCH_ROWS),
+            filled: 0,
+            out_input: Vec::new(),
+            out_cells: Vec::new(),
+            encoded: Vec::new(),
+            encoded_runs: 0,
+        }
+    }
+
+    /// Reads up to [`BATCH_ROWS`] records, reusing the rows in place (a row holds a solver's
+    /// fixed-capacity result, a kilobyte or more: moving rows would cost more than solving).
+    fn fill(&mut self, source: &mut CsvSource, rows: usize) -> Result<(), VerneError> {
+        self.filled = 0;
+        self.encoded_runs = 0;
+        while self.filled < rows {
+            if self.filled == self.rows.len() {
+                self.rows.push(PendingRow {
+                    record: ByteRecord::new(),
+                    values: [0.0; MAX_INPUTS],
+                    invalid: None,
+                    not_a_number: None,
+                    solved: S::default(),
+                });
+            }
+            if !source.read(&mut self.rows[self.filled].record)? {
+                break;
+            }
+            self.filled += 1;
+        }
+        Ok(())
+    }
+
+    fn write(&self, sink: &mut Sink) -> Result<(), VerneError> {
+        for bytes in &self.encoded[..self.encoded_runs] {
+            sink.write_encoded(bytes)?;
+        }
+        Ok(())
+    }
+}
+
+/// Rows handed to one thread at a time, for solving and for encoding.
+pub const RUN_ROWS: usize = 256;
+
+/// What stays fixed over a run.
+struct Plan<'a> {
+    inputs: &'a [(&'static str, bool)],
+    idx: &'a [usize],
+    slots: &'a [Slot],
+    n_computed: usize,
+    units: Units,
+    delimiter: u8,
+    file: &'a str,
 }
 
 /// Progress callback: rows done so far.
@@ -183,6 +264,9 @@ pub type Progress<'a> = &'a (dyn Fn(u64) + Sync);
 
 /// Runs a job over a CSV source into a sink. Fatal errors stop the run (the sink is then
 /// discarded by the caller); row-level problems are written as statuses and counted.
+///
+/// Three batches are in flight: while one is read (CSV parsing, in order), the previous one is
+/// solved and encoded (in parallel, emitted in order) and the one before is written.
 pub fn run<J: RowJob>(
     job: &mut J,
     source: &mut CsvSource,
@@ -196,7 +280,7 @@ pub fn run<J: RowJob>(
     let names: Vec<&str> = inputs.iter().map(|(n, _)| *n).collect();
     let idx = source.require(&names)?;
     // Output plan: input columns (computed ones replace same-named inputs), then the rest.
-    let mut plan = Vec::new();
+    let mut slots = Vec::new();
     let mut header = ByteRecord::new();
     if units.halstreamer {
         for name in HALSTREAMER_COLUMNS {
@@ -206,149 +290,220 @@ pub fn run<J: RowJob>(
                     HALSTREAMER_COLUMNS.join(",")
                 )));
             };
-            plan.push(Slot::Computed(k));
+            slots.push(Slot::Computed(k));
         }
     } else {
         for (i, h) in source.headers().iter().enumerate() {
             match outputs.iter().position(|o| o.as_bytes() == h) {
-                Some(k) => plan.push(Slot::Computed(k)),
-                None => plan.push(Slot::Input(i)),
+                Some(k) => slots.push(Slot::Computed(k)),
+                None => slots.push(Slot::Input(i)),
             }
             header.push_field(h);
         }
         for (k, o) in outputs.iter().enumerate() {
             if source.column(o).is_none() {
-                plan.push(Slot::Computed(k));
+                slots.push(Slot::Computed(k));
                 header.push_field(o.as_bytes());
             }
         }
         sink.write(&header)?;
     }
-    let status_col = outputs.len() - 1;
     let file = source.name().to_string();
+    // Computed cells (numbers, `ok`, reason codes joined by `;`) are written unquoted.
+    debug_assert!(matches!(sink.delimiter(), b',' | b' ' | b'\t'));
+    let plan = Plan {
+        inputs: &inputs,
+        idx: &idx,
+        slots: &slots,
+        n_computed: outputs.len(),
+        units,
+        delimiter: sink.delimiter(),
+        file: &file,
+    };
     let mut summary = RunSummary::default();
-    let mut batch: Vec<PendingRow<J::Solved>> = Vec::with_capacity(BATCH_ROWS);
-    let mut record = ByteRecord::new();
-    let mut scratch = Vec::with_capacity(64);
-    let mut out_cells = vec![Cell::Empty; outputs.len()];
-    loop {
-        // Fill a batch, reusing its rows in place (a row holds a solver's fixed-capacity result,
-        // a kilobyte or more: moving rows would cost more than solving them).
-        let mut filled = 0;
-        while filled < BATCH_ROWS {
-            if filled == batch.len() {
-                batch.push(PendingRow {
-                    record: ByteRecord::new(),
-                    values: [0.0; MAX_INPUTS],
-                    invalid: None,
-                    solved: J::Solved::default(),
-                });
-            }
-            let row = &mut batch[filled];
-            if !source.read(&mut row.record)? {
-                break;
-            }
-            row.invalid = None;
-            for (k, &i) in idx.iter().enumerate() {
-                let field = row.record.get(i).unwrap_or(b"");
-                match parse_number(field) {
-                    Ok(v) => {
-                        row.values[k] = if inputs[k].1 && !units.radians {
-                            v.to_radians()
-                        } else {
-                            v
-                        }
-                    }
-                    Err(CellError::NotFinite) => {
-                        if row.invalid.is_none() {
-                            row.invalid = Some(k);
-                        }
-                    }
-                    Err(CellError::NotANumber) => {
-                        let line = row.record.position().map(|p| p.line());
-                        return Err(VerneError::input(
-                            &file,
-                            line,
-                            Some(inputs[k].0),
-                            format!(
-                                "expected a number{}, found `{}`",
-                                if inputs[k].1 {
-                                    if units.radians {
-                                        " (radians)"
-                                    } else {
-                                        " (degrees)"
-                                    }
-                                } else {
-                                    " (mm)"
-                                },
-                                shown(field)
-                            ),
-                        ));
-                    }
-                }
-            }
-            filled += 1;
-        }
-        if filled == 0 {
-            break;
-        }
-        // Solve in parallel.
-        let n_in = inputs.len();
-        let job_ref: &J = job;
-        batch[..filled]
-            .par_iter_mut()
-            .with_min_len(64)
-            .for_each(|row| {
-                if row.invalid.is_none() {
-                    job_ref.solve(&row.values[..n_in], &mut row.solved);
-                }
-            });
-        // Emit in order.
-        for row in &batch[..filled] {
-            summary.input_rows += 1;
-            let line = row.record.position().map(|p| p.line()).unwrap_or(0);
-            let mut writer = RowWriter {
-                plan: &plan,
-                input: &row.record,
-                record: &mut record,
-                scratch: &mut scratch,
-                sink,
-                units,
-                n_computed: outputs.len(),
-                rows: 0,
-            };
-            let outcome = if row.invalid.is_some() {
-                out_cells.iter_mut().for_each(|c| *c = Cell::Empty);
-                out_cells[status_col] = Cell::Str("invalid_input");
-                writer.row(&out_cells)?;
-                RowOutcome {
-                    ok: false,
-                    status: Cell::Str("invalid_input"),
-                }
-            } else {
-                job.emit(&row.solved, &mut writer)?
-            };
-            summary.output_rows += writer.rows;
-            if outcome.ok {
-                summary.ok_rows += 1;
-            } else {
-                scratch.clear();
-                write_cell(&mut scratch, outcome.status, units);
-                let text = String::from_utf8_lossy(&scratch).into_owned();
-                if units.halstreamer {
-                    return Err(VerneError::input(
-                        &file,
-                        Some(line),
-                        None,
-                        format!(
-                            "row status `{text}`: a halstreamer joint list cannot leave out a row; fix the path or use CSV output to see every row's status"
-                        ),
-                    ));
-                }
-                summary.count(&text, line);
-            }
-        }
+    let (mut reading, mut solving, mut writing) =
+        (Batch::<J::Solved>::new(), Batch::new(), Batch::new());
+    // The first batch is small: its output rows per input row size the next ones.
+    let mut batch_rows = RUN_ROWS;
+    reading.fill(source, batch_rows)?;
+    while reading.filled > 0 {
+        std::mem::swap(&mut reading, &mut solving);
+        let (read, (written, solved)) = rayon::join(
+            || reading.fill(source, batch_rows),
+            || {
+                rayon::join(
+                    || writing.write(sink),
+                    || process(job, &mut solving, &plan, &mut summary),
+                )
+            },
+        );
+        written?;
+        solved?;
+        read?;
         progress(summary.input_rows);
+        // Rows per batch for the batch after next, from this one's output rows per input row.
+        let per_input = solving
+            .out_input
+            .len()
+            .div_ceil(solving.filled.max(1))
+            .max(1);
+        batch_rows = (BATCH_OUTPUT_ROWS / per_input).clamp(RUN_ROWS, BATCH_ROWS);
+        std::mem::swap(&mut solving, &mut writing);
     }
+    writing.write(sink)?;
     Ok(summary)
+}
+
+/// Parses, solves, emits and encodes one batch.
+fn process<J: RowJob>(
+    job: &mut J,
+    batch: &mut Batch<J::Solved>,
+    plan: &Plan<'_>,
+    summary: &mut RunSummary,
+) -> Result<(), VerneError> {
+    let rows = &mut batch.rows[..batch.filled];
+    // Parse and solve, in runs of consecutive rows.
+    let job_ref: &J = job;
+    rows.par_chunks_mut(RUN_ROWS).for_each(|run| {
+        for row in run.iter_mut() {
+            parse_row(row, plan);
+        }
+        let n_in = plan.inputs.len();
+        job_ref.solve_run(&mut run.iter_mut().map(|row| {
+            let PendingRow {
+                values,
+                invalid,
+                not_a_number,
+                solved,
+                ..
+            } = row;
+            let ok = invalid.is_none() && not_a_number.is_none();
+            (ok.then_some(&values[..n_in]), solved)
+        }));
+    });
+    // A cell that is not a number stops the run at the first such row.
+    if let Some(row) = rows.iter().find(|r| r.not_a_number.is_some()) {
+        let k = row.not_a_number.unwrap_or(0);
+        let field = row.record.get(plan.idx[k]).unwrap_or(b"");
+        let line = row.record.position().map(|p| p.line());
+        let unit = match (plan.inputs[k].1, plan.units.radians) {
+            (false, _) => " (mm)",
+            (true, true) => " (radians)",
+            (true, false) => " (degrees)",
+        };
+        return Err(VerneError::input(
+            plan.file,
+            line,
+            Some(plan.inputs[k].0),
+            format!("expected a number{unit}, found `{}`", shown(field)),
+        ));
+    }
+    // Emit in order (a job may carry state from row to row).
+    batch.out_input.clear();
+    batch.out_cells.clear();
+    let status_col = plan.n_computed - 1;
+    let mut cells = vec![Cell::Empty; plan.n_computed];
+    let mut scratch = Vec::new();
+    for (i, row) in rows.iter().enumerate() {
+        summary.input_rows += 1;
+        let line = row.record.position().map(|p| p.line()).unwrap_or(0);
+        let mut writer = RowWriter {
+            input: i as u32,
+            out_input: &mut batch.out_input,
+            out_cells: &mut batch.out_cells,
+            units: plan.units,
+            n_computed: plan.n_computed,
+            rows: 0,
+        };
+        let outcome = if row.invalid.is_some() {
+            cells.iter_mut().for_each(|c| *c = Cell::Empty);
+            cells[status_col] = Cell::Str("invalid_input");
+            writer.row(&cells)?;
+            RowOutcome {
+                ok: false,
+                status: Cell::Str("invalid_input"),
+            }
+        } else {
+            job.emit(&row.solved, &mut writer)?
+        };
+        summary.output_rows += writer.rows;
+        if outcome.ok {
+            summary.ok_rows += 1;
+        } else {
+            scratch.clear();
+            write_cell(&mut scratch, outcome.status, plan.units);
+            let text = String::from_utf8_lossy(&scratch).into_owned();
+            if plan.units.halstreamer {
+                return Err(VerneError::input(
+                    plan.file,
+                    Some(line),
+                    None,
+                    format!(
+                        "row status `{text}`: a halstreamer joint list cannot leave out a row; fix the path or use CSV output to see every row's status"
+                    ),
+                ));
+            }
+            summary.count(&text, line);
+        }
+    }
+    // Encode, in runs of output rows.
+    let n_out = batch.out_input.len();
+    batch.encoded_runs = n_out.div_ceil(RUN_ROWS);
+    if batch.encoded.len() < batch.encoded_runs {
+        batch.encoded.resize_with(batch.encoded_runs, Vec::new);
+    }
+    let (out_input, out_cells, rows) = (&batch.out_input, &batch.out_cells, &batch.rows);
+    batch.encoded[..batch.encoded_runs]
+        .par_iter_mut()
+        .enumerate()
+        .for_each(|(j, bytes)| {
+            bytes.clear();
+            for o in j * RUN_ROWS..n_out.min((j + 1) * RUN_ROWS) {
+                let input = &rows[out_input[o] as usize].record;
+                let cells = &out_cells[o * plan.n_computed..(o + 1) * plan.n_computed];
+                for (f, slot) in plan.slots.iter().enumerate() {
+                    match *slot {
+                        Slot::Input(i) => {
+                            let field = input.get(i).unwrap_or(b"");
+                            encode_field(bytes, plan.delimiter, f == 0, field);
+                        }
+                        Slot::Computed(k) => {
+                            // Numbers and status codes never need quotes: written in place.
+                            if f > 0 {
+                                bytes.push(plan.delimiter);
+                            }
+                            write_cell(bytes, cells[k], plan.units);
+                        }
+                    }
+                }
+                bytes.push(b'\n');
+            }
+        });
+    Ok(())
+}
+
+/// Parses a row's input columns (converting degrees), marking empty or non-finite cells
+/// (the row is invalid) and cells that are not numbers (a fatal error).
+fn parse_row<S>(row: &mut PendingRow<S>, plan: &Plan<'_>) {
+    row.invalid = None;
+    row.not_a_number = None;
+    for (k, &i) in plan.idx.iter().enumerate() {
+        let field = row.record.get(i).unwrap_or(b"");
+        match parse_number(field) {
+            Ok(v) => {
+                row.values[k] = if plan.inputs[k].1 && !plan.units.radians {
+                    v.to_radians()
+                } else {
+                    v
+                }
+            }
+            Err(CellError::NotFinite) => {
+                row.invalid.get_or_insert(k);
+            }
+            Err(CellError::NotANumber) => {
+                row.not_a_number = Some(k);
+                return;
+            }
+        }
+    }
 }

@@ -15,6 +15,8 @@ pub struct CsvSource {
     reader: csv::Reader<Box<dyn Read + Send>>,
     name: String,
     headers: ByteRecord,
+    /// The record as read, before its fields are trimmed into the caller's record.
+    raw: ByteRecord,
 }
 
 impl CsvSource {
@@ -35,7 +37,8 @@ impl CsvSource {
     pub fn from_reader(r: Box<dyn Read + Send>, name: &str) -> Result<CsvSource, VerneError> {
         let mut reader = csv::ReaderBuilder::new()
             .has_headers(true)
-            .trim(csv::Trim::All)
+            // Fields are trimmed by `read` without the per-record allocation of Trim::All.
+            .trim(csv::Trim::Headers)
             .comment(None)
             .buffer_capacity(1 << 16)
             .from_reader(r);
@@ -65,6 +68,7 @@ impl CsvSource {
             reader,
             name: name.to_string(),
             headers: headers_clean,
+            raw: ByteRecord::new(),
         };
         src.check_duplicate_headers()?;
         Ok(src)
@@ -140,11 +144,27 @@ impl CsvSource {
     }
 
     /// Reads the next record into `rec`; false at the end of the input.
+    /// Every field has its surrounding ASCII white space removed.
     pub fn read(&mut self, rec: &mut ByteRecord) -> Result<bool, VerneError> {
-        match self.reader.read_byte_record(rec) {
-            Ok(more) => Ok(more),
-            Err(e) => Err(csv_error(&self.name, e)),
+        match self.reader.read_byte_record(&mut self.raw) {
+            Ok(true) => {}
+            Ok(false) => return Ok(false),
+            Err(e) => return Err(csv_error(&self.name, e)),
         }
+        let padded = |f: &[u8]| {
+            f.first().is_some_and(u8::is_ascii_whitespace)
+                || f.last().is_some_and(u8::is_ascii_whitespace)
+        };
+        if self.raw.iter().any(padded) {
+            rec.clear();
+            rec.set_position(self.raw.position().cloned());
+            for f in self.raw.iter() {
+                rec.push_field(f.trim_ascii());
+            }
+        } else {
+            std::mem::swap(rec, &mut self.raw);
+        }
+        Ok(true)
     }
 }
 
@@ -207,9 +227,36 @@ pub fn parse_number(field: &[u8]) -> Result<f64, CellError> {
     }
 }
 
-/// Where output goes: stdout, or a file written atomically.
+/// Appends one field of a CSV record: after a `delimiter` unless it is the first, quoted only
+/// where needed, as the csv crate's writer does (a field holding the delimiter, a quote, CR or
+/// LF; quotes inside doubled).
+#[inline]
+pub fn encode_field(out: &mut Vec<u8>, delimiter: u8, first: bool, field: &[u8]) {
+    if !first {
+        out.push(delimiter);
+    }
+    // Bytes above b'"' other than the delimiter never need quotes: one comparison per byte.
+    let special = |b: u8| b <= b'"' && (b == b'"' || b == b'\n' || b == b'\r' || b == delimiter);
+    if !field.iter().any(|&b| special(b) || b == delimiter) {
+        out.extend_from_slice(field);
+        return;
+    }
+    out.push(b'"');
+    for &b in field {
+        if b == b'"' {
+            out.push(b'"');
+        }
+        out.push(b);
+    }
+    out.push(b'"');
+}
+
+/// Where output goes: stdout, or a file written atomically. Records are CSV-encoded by
+/// [`encode_field`]; a caller may also hand over text it encoded itself ([`Sink::write_encoded`]).
 pub struct Sink {
-    writer: csv::Writer<Box<dyn Write + Send>>,
+    writer: Box<dyn Write + Send>,
+    delimiter: u8,
+    scratch: Vec<u8>,
     target: Option<(PathBuf, PathBuf)>,
     name: String,
 }
@@ -222,7 +269,7 @@ impl Sink {
 
     /// As [`Sink::create`], with another field delimiter (b' ' for halstreamer).
     pub fn create_delimited(path: Option<&Path>, delimiter: u8) -> Result<Sink, VerneError> {
-        let (inner, target, name): (Box<dyn Write + Send>, _, String) = match path {
+        let (writer, target, name): (Box<dyn Write + Send>, _, String) = match path {
             Some(p) if p.as_os_str() != "-" => {
                 let name = p.display().to_string();
                 let tmp = temp_path_for(p);
@@ -243,9 +290,9 @@ impl Sink {
             crate::table::register_temp(tmp);
         }
         Ok(Sink {
-            writer: csv::WriterBuilder::new()
-                .delimiter(delimiter)
-                .from_writer(inner),
+            writer,
+            delimiter,
+            scratch: Vec::new(),
             target,
             name,
         })
@@ -254,23 +301,48 @@ impl Sink {
     /// A sink over any writer (tests, fuzzing, in-memory output).
     pub fn from_writer(w: Box<dyn Write + Send>, name: &str) -> Sink {
         Sink {
-            writer: csv::WriterBuilder::new().from_writer(w),
+            writer: w,
+            delimiter: b',',
+            scratch: Vec::new(),
             target: None,
             name: name.to_string(),
         }
     }
 
-    pub fn write(&mut self, rec: &ByteRecord) -> Result<(), VerneError> {
-        self.writer
-            .write_byte_record(rec)
-            .map_err(|e| self.io_error(e))
+    /// The field delimiter of the records this sink writes.
+    pub fn delimiter(&self) -> u8 {
+        self.delimiter
     }
 
-    fn io_error(&self, e: csv::Error) -> VerneError {
-        match e.into_kind() {
-            csv::ErrorKind::Io(io) => VerneError::io(&self.name, io),
-            other => VerneError::io(&self.name, io::Error::other(format!("{other:?}"))),
+    /// Writes one record.
+    pub fn write(&mut self, rec: &ByteRecord) -> Result<(), VerneError> {
+        self.scratch.clear();
+        if rec.len() == 1 && rec[0].is_empty() {
+            // A lone empty field is written quoted, or the line would read as no record.
+            self.scratch.extend_from_slice(b"\"\"");
+        } else {
+            for (i, f) in rec.iter().enumerate() {
+                encode_field(&mut self.scratch, self.delimiter, i == 0, f);
+            }
         }
+        self.scratch.push(b'\n');
+        let Sink {
+            writer,
+            scratch,
+            name,
+            ..
+        } = self;
+        writer
+            .write_all(scratch)
+            .map_err(|e| VerneError::io(name, e))
+    }
+
+    /// Writes records already encoded (with [`encode_field`] and this sink's delimiter, each
+    /// ended by a line feed).
+    pub fn write_encoded(&mut self, bytes: &[u8]) -> Result<(), VerneError> {
+        self.writer
+            .write_all(bytes)
+            .map_err(|e| VerneError::io(&self.name, e))
     }
 
     /// Flushes and, for a file, renames the temporary file into place.
@@ -284,25 +356,8 @@ impl Sink {
             return Err(e);
         }
         if let Some((tmp, dest)) = self.target.take() {
-            // Drop the writer (closing the file) before renaming.
-            let writer = std::mem::replace(
-                &mut self.writer,
-                csv::Writer::from_writer(Box::new(io::sink())),
-            );
-            match writer.into_inner() {
-                Ok(mut inner) => {
-                    if let Err(e) = inner.flush() {
-                        let _ = std::fs::remove_file(&tmp);
-                        unregister_temp(&tmp);
-                        return Err(VerneError::io(&self.name, e));
-                    }
-                }
-                Err(e) => {
-                    let _ = std::fs::remove_file(&tmp);
-                    unregister_temp(&tmp);
-                    return Err(VerneError::io(&self.name, e.into_error()));
-                }
-            }
+            // Close the file before renaming.
+            drop(std::mem::replace(&mut self.writer, Box::new(io::sink())));
             let renamed = std::fs::rename(&tmp, &dest);
             unregister_temp(&tmp);
             if let Err(e) = renamed {

@@ -154,3 +154,121 @@ fn working_fast_matches_the_complete_solver_near_hand_over_places() {
     }
     check(pts.into_iter(), &m);
 }
+
+// ------------------------------------------------------------ FK: the working mode tracked
+
+use verne::fk_track::FkTracker;
+use verne::module_fk::{self, FkModes};
+use verne::module_geometry::Sliders;
+
+/// Compares the tracked working mode with the complete solver's on every row of a path;
+/// returns (rows with a working mode, rows answered by tracking).
+fn tracked_agrees(m: &Machine, path: &[Sliders]) -> (usize, u64) {
+    let mut tracker = FkTracker::new(m);
+    let mut modes = FkModes::new();
+    let mut present = 0;
+    for rho in path {
+        tracker.working_into(rho, &mut modes);
+        let t = &module_fk::working(&modes).copied();
+        let full = module_fk::solve(m, rho);
+        let e = module_fk::working(&full);
+        assert_eq!(
+            t.is_some(),
+            e.is_some(),
+            "rho={rho:?}: tracked {t:?} vs {e:?}"
+        );
+        if let (Some(t), Some(e)) = (t, e) {
+            present += 1;
+            let (da, dp) = (
+                (t.pose.alpha - e.pose.alpha).abs(),
+                (t.pose.p - e.pose.p).amax(),
+            );
+            assert!(
+                da < 1e-11 && dp < 1e-9 && t.config == e.config && t.verdict == e.verdict,
+                "rho={rho:?}: tracked {t:?} vs {e:?} (d alpha {da:e}, d p {dp:e})"
+            );
+        }
+    }
+    (present, tracker.tracked)
+}
+
+/// Joints of the working branch along a helix of P (the path of the benchmarks).
+fn helix_joints(m: &Machine, rows: usize) -> Vec<Sliders> {
+    (0..rows)
+        .filter_map(|k| {
+            let t = k as f64 / rows as f64;
+            let a = t * std::f64::consts::TAU;
+            let p = Vector3::new(
+                -250.0 + 120.0 * a.cos(),
+                120.0 * a.sin(),
+                1000.0 + 300.0 * t,
+            );
+            module_ik::working(&module_ik::solve(m, &p)).map(|b| b.rho)
+        })
+        .collect()
+}
+
+#[test]
+fn tracked_fk_matches_the_complete_solver_along_a_helix() {
+    let m = Machine::default_verne();
+    let path = helix_joints(&m, 4096);
+    let (present, tracked) = tracked_agrees(&m, &path);
+    assert_eq!(present, path.len());
+    // Only the first row needs the complete solution.
+    assert_eq!(tracked as usize, path.len() - 1);
+}
+
+/// Along rays in joint space through the place where the working mode ends (it meets another
+/// mode at a parallel singularity, or leaves a limit), forwards and back at 0.05 mm per row.
+#[test]
+fn tracked_fk_matches_the_complete_solver_through_branch_switches() {
+    let m = Machine::default_verne();
+    let starts = helix_joints(&m, 64);
+    let mut r = Lcg(3);
+    let (mut crossings, mut meeting, mut rows_present, mut tracked) = (0, 0, 0, 0);
+    for start in starts {
+        for _ in 0..6 {
+            let dir = Vector3::new(r.unit() - 0.5, r.unit() - 0.5, r.unit() - 0.5).normalize();
+            let has =
+                |s: f64| module_fk::working(&module_fk::solve(&m, &(start + dir * s))).is_some();
+            let (mut a, mut b) = (0.0, 2000.0);
+            if has(b) {
+                continue;
+            }
+            for _ in 0..50 {
+                let mid = 0.5 * (a + b);
+                if has(mid) { a = mid } else { b = mid }
+            }
+            crossings += 1;
+            // Is it a branch switch: does another mode come within 0.01 rad at the last row?
+            let last = module_fk::solve(&m, &(start + dir * a));
+            let w = module_fk::working(&last)
+                .map(|w| w.pose.alpha)
+                .unwrap_or(f64::NAN);
+            meeting += last
+                .iter()
+                .any(|md| md.pose.alpha != w && (md.pose.alpha - w).abs() < 0.01)
+                as usize;
+            let forward: Vec<Sliders> = (0..=400)
+                .map(|k| start + dir * (a - 10.0 + 0.05 * k as f64))
+                .collect();
+            let back: Vec<Sliders> = forward.iter().rev().copied().collect();
+            for path in [forward, back] {
+                let (present, t) = tracked_agrees(&m, &path);
+                rows_present += present;
+                tracked += t as usize;
+            }
+        }
+    }
+    eprintln!(
+        "{crossings} crossings, {meeting} where two modes meet; {tracked} of {rows_present} rows with a working mode tracked"
+    );
+    assert!(
+        crossings > 100 && meeting > 20,
+        "{crossings} crossings, {meeting} meeting"
+    );
+    assert!(
+        tracked * 10 > rows_present * 9,
+        "{tracked} of {rows_present}"
+    );
+}

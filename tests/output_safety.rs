@@ -187,3 +187,36 @@ fn every_input_row_yields_one_output_row() {
         }
     }
 }
+
+/// The output does not depend on the number of threads: batches and runs start at fixed rows,
+/// so `verne fk`'s tracking restarts at the same rows whatever the pool.
+#[test]
+fn output_is_the_same_with_one_and_two_threads() {
+    let run = |args: &[&str], input: &str, threads: &str| {
+        let mut child = Command::new(BIN)
+            .args(args)
+            .env("RAYON_NUM_THREADS", threads)
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        let mut stdin = child.stdin.take().unwrap();
+        let text = input.to_string();
+        let writer = std::thread::spawn(move || stdin.write_all(text.as_bytes()));
+        let out = child.wait_with_output().unwrap();
+        writer.join().unwrap().unwrap();
+        out.stdout
+    };
+    let path = path_csv(5000);
+    let joints = run(&["ik"], &path, "2");
+    assert_eq!(joints, run(&["ik"], &path, "1"));
+    let joints = String::from_utf8(joints).unwrap();
+    assert_eq!(joints.lines().count(), 5001);
+    for args in [&["fk"][..], &["fk", "--all"][..]] {
+        let two = run(args, &joints, "2");
+        assert!(two.len() > joints.len(), "{args:?}");
+        assert_eq!(two, run(args, &joints, "1"), "{args:?}");
+        assert_eq!(two, run(args, &joints, "3"), "{args:?}");
+    }
+}
