@@ -471,18 +471,6 @@ fn fk_characteristic(g: &ModuleGeometry, rho: &Sliders) -> Trig {
     u_num.mul(&u_num).add(&inner.scale(4.0 * delta * delta))
 }
 
-/// Both half-angle charts of F, normalised as `module_fk` does.
-fn fk_charts(f: &Trig) -> [verne::poly::Coeffs; 2] {
-    [false, true].map(|shift| {
-        let mut poly = f.to_half_angle_poly(shift);
-        let scale = poly.iter().fold(0.0f64, |m, a| m.max(a.abs()));
-        for a in poly.iter_mut() {
-            *a /= scale;
-        }
-        poly
-    })
-}
-
 /// The cubic (9) in cos(alpha), normalised as `module_ik` does.
 fn ik_cubic(g: &ModuleGeometry, p: &Vector3<f64>) -> [f64; 4] {
     let (r, rr) = (g.r_big1, g.r_small1);
@@ -851,12 +839,8 @@ const PARTS: &[(&str, &str)] = &[
         "F(alpha) from the sliders (Trig products), per row",
     ),
     (
-        "parts/fk_half_angle_charts",
-        "both degree-8 charts + normalisation, per row",
-    ),
-    (
-        "parts/fk_roots_in_both_charts",
-        "roots_in on both degree-8 charts, per row",
+        "parts/fk_trig_roots",
+        "Trig::roots of F over the circle, per row",
     ),
     (
         "parts/fk_polish_pose_exact",
@@ -968,19 +952,10 @@ fn main() {
             .sum::<f64>()
     });
     let chars: Vec<Trig> = path_rho.iter().map(|r| fk_characteristic(&g, r)).collect();
-    bench(&mut c, &rec, "parts", "fk_half_angle_charts", n, || {
+    bench(&mut c, &rec, "parts", "fk_trig_roots", n, || {
         chars
             .iter()
-            .map(|f| fk_charts(black_box(f))[1][0])
-            .sum::<f64>()
-    });
-    let charts: Vec<[verne::poly::Coeffs; 2]> = chars.iter().map(fk_charts).collect();
-    bench(&mut c, &rec, "parts", "fk_roots_in_both_charts", n, || {
-        charts
-            .iter()
-            .map(|[a, b]| {
-                roots_in(black_box(a), -1.0, 1.0).len() + roots_in(black_box(b), -1.0, 1.0).len()
-            })
+            .map(|f| black_box(f).roots().len())
             .sum::<usize>()
     });
     bench(&mut c, &rec, "parts", "fk_polish_pose_exact", n, || {

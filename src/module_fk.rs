@@ -18,8 +18,9 @@
 //!   F(alpha) = U^2 + 4 delta^2 (b^2 (R1^2 + r1^2 - 2 R1 r1 c) - K1 Det^2) = 0,
 //!
 //! a trigonometric polynomial of degree 4: with t = tan(alpha/2), (1 + t^2)^4 F is the paper's
-//! degree-8 polynomial. Its real roots are isolated in two charts (t in [-1, 1] and
-//! t' = tan((alpha - pi)/2) in [-1, 1]) so that alpha = pi is an ordinary root. Every root is
+//! degree-8 polynomial. Its real roots are isolated directly on the circle by `Trig::roots`
+//! (certified exclusion and monotonicity tests on a grid, the half-angle charts only around a
+//! near-double root). Every root is
 //! back-substituted and polished by Newton on the original equations (3)-(6); where Det ~ 0
 //! (condition (21)) the point is found instead as the intersection of the four spheres at that
 //! alpha, which also yields the two solutions of a degenerate alpha.
@@ -29,9 +30,8 @@ use nalgebra::{Matrix3, Vector3};
 
 use crate::branches::{Config, Verdict, config_of, module_verdict};
 use crate::machine::{Machine, ModuleGeometry};
-use crate::module_geometry::{ModulePose, Sliders, polish_pose, residual_mm};
+use crate::module_geometry::{ModulePose, Sliders, polish_pose_with_residual, residual_mm};
 use crate::module_ik::wrap_angle;
-use crate::poly::roots_in;
 use crate::tolerance::{ACCEPT_RESIDUAL_MM, FK_DET_REL, SAME_SOLUTION_MM, SAME_SOLUTION_RAD};
 use crate::trig::Trig;
 
@@ -116,16 +116,16 @@ impl Elimination {
 
     /// The pose at `alpha` from the linear solution, or None where Det ~ 0.
     fn back_substitute(&self, g: &ModuleGeometry, rho: &Sliders, alpha: f64) -> Option<ModulePose> {
-        let det = self.det.eval(alpha);
+        let (s, c) = alpha.sin_cos();
+        let det = self.det.eval_sc(s, c);
         let det_scale = self.det.cos[0].abs() + self.det.cos[1].abs() + self.det.sin[1].abs();
         if det.abs() <= FK_DET_REL * det_scale || det_scale == 0.0 {
             return None;
         }
-        let s = alpha.sin();
-        let b = self.b.eval(alpha);
+        let b = self.b.eval_sc(s, c);
         let y = -g.r_big1 * s * b / det;
-        let zp = self.w.eval(alpha) * b / det;
-        let u = self.u_num.eval(alpha) / (2.0 * self.delta * det);
+        let zp = self.w.eval_sc(s, c) * b / det;
+        let u = self.u_num.eval_sc(s, c) / (2.0 * self.delta * det);
         Some(ModulePose {
             p: Vector3::new(u - g.dx1, y, zp + rho.x),
             alpha,
@@ -220,28 +220,6 @@ fn det_zeros(det: &Trig) -> ArrayVec<f64, 2> {
     out
 }
 
-/// The real roots alpha of F, from both half-angle charts.
-fn characteristic_roots(f: &Trig) -> ArrayVec<f64, 32> {
-    let mut alphas = ArrayVec::new();
-    for shift in [false, true] {
-        let mut poly = f.to_half_angle_poly(shift);
-        let scale = poly.iter().fold(0.0f64, |m, a| m.max(a.abs()));
-        if scale == 0.0 || !scale.is_finite() {
-            return alphas;
-        }
-        for a in poly.iter_mut() {
-            *a /= scale;
-        }
-        for root in roots_in(&poly, -1.0, 1.0) {
-            let alpha = 2.0 * root.x.atan() + if shift { std::f64::consts::PI } else { 0.0 };
-            if !alphas.is_full() {
-                alphas.push(wrap_angle(alpha));
-            }
-        }
-    }
-    alphas
-}
-
 /// Every real assembly mode for the slider positions, ordered by alpha, each with its
 /// configuration and verdict. Empty when the sliders cannot be assembled.
 pub fn solve(m: &Machine, rho: &Sliders) -> FkModes {
@@ -253,7 +231,7 @@ pub fn solve(m: &Machine, rho: &Sliders) -> FkModes {
     let elim = Elimination::new(g, rho);
     let f = elim.characteristic(g);
     let mut starts: ArrayVec<ModulePose, 68> = ArrayVec::new();
-    for alpha in characteristic_roots(&f) {
+    for alpha in f.roots() {
         match elim.back_substitute(g, rho, alpha) {
             Some(p) => starts.push(p),
             None => starts.extend(fixed_alpha_points(g, rho, alpha)),
@@ -277,14 +255,14 @@ pub fn solve(m: &Machine, rho: &Sliders) -> FkModes {
         starts.extend(on_spheres);
     }
     for start in starts {
-        let pose = polish_pose(g, start, rho);
+        let (pose, residual) = polish_pose_with_residual(g, start, rho);
+        if residual > ACCEPT_RESIDUAL_MM {
+            continue;
+        }
         let pose = ModulePose {
             alpha: wrap_angle(pose.alpha),
             ..pose
         };
-        if residual_mm(g, &pose, rho) > ACCEPT_RESIDUAL_MM {
-            continue;
-        }
         let dup = out.iter().any(|o| {
             wrap_angle(o.pose.alpha - pose.alpha).abs() < SAME_SOLUTION_RAD
                 && (o.pose.p - pose.p).amax() < SAME_SOLUTION_MM * (1.0 + pose.p.amax())

@@ -20,6 +20,18 @@ pub type Sliders = Vector3<f64>;
 #[inline]
 pub fn rod_vectors(g: &ModuleGeometry, pose: &ModulePose, rho: &Sliders) -> [Vector3<f64>; 4] {
     let (s, c) = pose.alpha.sin_cos();
+    rod_vectors_sc(g, pose, rho, s, c)
+}
+
+/// [`rod_vectors`] with (sin alpha, cos alpha) given.
+#[inline]
+fn rod_vectors_sc(
+    g: &ModuleGeometry,
+    pose: &ModulePose,
+    rho: &Sliders,
+    s: f64,
+    c: f64,
+) -> [Vector3<f64>; 4] {
     let (x, y, z) = (pose.p.x, pose.p.y, pose.p.z);
     [
         Vector3::new(
@@ -60,8 +72,7 @@ pub fn residual_mm(g: &ModuleGeometry, pose: &ModulePose, rho: &Sliders) -> f64 
 
 /// Derivatives of each rod vector with respect to alpha.
 #[inline]
-fn rod_vectors_d_alpha(g: &ModuleGeometry, alpha: f64) -> [Vector3<f64>; 4] {
-    let (s, c) = alpha.sin_cos();
+fn rod_vectors_d_alpha(g: &ModuleGeometry, s: f64, c: f64) -> [Vector3<f64>; 4] {
     [
         Vector3::new(0.0, -g.r_big1 * s, g.r_big1 * c),
         Vector3::new(0.0, g.r_big1 * s, -g.r_big1 * c),
@@ -73,8 +84,14 @@ fn rod_vectors_d_alpha(g: &ModuleGeometry, alpha: f64) -> [Vector3<f64>; 4] {
 /// A = d(residuals)/d(xp, yp, zp, alpha): the parallel Jacobian (4x4). det A = 0 is a parallel
 /// singularity (two assembly modes meet).
 pub fn jacobian_pose(g: &ModuleGeometry, pose: &ModulePose, rho: &Sliders) -> Matrix4<f64> {
-    let v = rod_vectors(g, pose, rho);
-    let dv = rod_vectors_d_alpha(g, pose.alpha);
+    let (s, c) = pose.alpha.sin_cos();
+    jacobian_at(&rod_vectors_sc(g, pose, rho, s, c), g, s, c)
+}
+
+/// [`jacobian_pose`] from the rod vectors and (sin alpha, cos alpha).
+#[inline]
+fn jacobian_at(v: &[Vector3<f64>; 4], g: &ModuleGeometry, s: f64, c: f64) -> Matrix4<f64> {
+    let dv = rod_vectors_d_alpha(g, s, c);
     let mut a = Matrix4::zeros();
     for i in 0..4 {
         a[(i, 0)] = 2.0 * v[i].x;
@@ -112,18 +129,28 @@ pub fn rod_tilts(g: &ModuleGeometry, pose: &ModulePose, rho: &Sliders) -> [f64; 
 /// Newton polish on eqs. (3)-(6) for the pose, sliders fixed (forward kinematics). Returns the
 /// polished pose when it did not make the residual worse.
 pub fn polish_pose(g: &ModuleGeometry, start: ModulePose, rho: &Sliders) -> ModulePose {
+    polish_pose_with_residual(g, start, rho).0
+}
+
+/// [`polish_pose`], with the returned pose's [`residual_mm`]. One sin_cos per Newton step: the
+/// residuals and the Jacobian A at each iterate come from the same rod vectors.
+pub fn polish_pose_with_residual(
+    g: &ModuleGeometry,
+    start: ModulePose,
+    rho: &Sliders,
+) -> (ModulePose, f64) {
     use crate::tolerance::{NEWTON_MAX_ITER, NEWTON_STEP_STOP};
     let l = rod_lengths(g);
     let as_mm = |f: &Vector4<f64>| (0..4).fold(0.0f64, |m, i| m.max((f[i] / (2.0 * l[i])).abs()));
     let mut cur = start;
-    let mut f = residuals(g, &cur, rho);
-    let mut best = (cur, as_mm(&f));
+    let (mut f, mut a) = residuals_and_jacobian(g, &cur, rho);
+    let mut res = as_mm(&f);
+    let mut best = (cur, res);
     for _ in 0..NEWTON_MAX_ITER {
-        if as_mm(&f) == 0.0 {
+        if res == 0.0 {
             break;
         }
-        let a = jacobian_pose(g, &cur, rho);
-        let Some(step) = a.lu().solve(&f) else { break };
+        let Some(step) = solve4(a, f) else { break };
         if !step.iter().all(|v| v.is_finite()) {
             break;
         }
@@ -131,8 +158,8 @@ pub fn polish_pose(g: &ModuleGeometry, start: ModulePose, rho: &Sliders) -> Modu
             p: cur.p - Vector3::new(step[0], step[1], step[2]),
             alpha: cur.alpha - step[3],
         };
-        f = residuals(g, &cur, rho);
-        let res = as_mm(&f);
+        (f, a) = residuals_and_jacobian(g, &cur, rho);
+        res = as_mm(&f);
         if res <= best.1 {
             best = (cur, res);
         }
@@ -140,7 +167,55 @@ pub fn polish_pose(g: &ModuleGeometry, start: ModulePose, rho: &Sliders) -> Modu
             break;
         }
     }
-    best.0
+    best
+}
+
+/// The residuals of eqs. (3)-(6) and the Jacobian A of [`jacobian_pose`], from one sin_cos.
+#[inline]
+fn residuals_and_jacobian(
+    g: &ModuleGeometry,
+    pose: &ModulePose,
+    rho: &Sliders,
+) -> (Vector4<f64>, Matrix4<f64>) {
+    let (s, c) = pose.alpha.sin_cos();
+    let v = rod_vectors_sc(g, pose, rho, s, c);
+    let l = rod_lengths(g);
+    let f = Vector4::from_fn(|i, _| v[i].norm_squared() - l[i] * l[i]);
+    (f, jacobian_at(&v, g, s, c))
+}
+
+/// a^-1 b by Gaussian elimination with partial pivoting; None when a pivot is zero.
+#[inline]
+fn solve4(mut a: Matrix4<f64>, mut b: Vector4<f64>) -> Option<Vector4<f64>> {
+    for k in 0..4 {
+        let p = (k..4)
+            .max_by(|&i, &j| a[(i, k)].abs().total_cmp(&a[(j, k)].abs()))
+            .unwrap_or(k);
+        if a[(p, k)] == 0.0 {
+            return None;
+        }
+        if p != k {
+            a.swap_rows(p, k);
+            b.swap_rows(p, k);
+        }
+        let inv = 1.0 / a[(k, k)];
+        for i in k + 1..4 {
+            let m = a[(i, k)] * inv;
+            for j in k + 1..4 {
+                a[(i, j)] -= m * a[(k, j)];
+            }
+            b[i] -= m * b[k];
+        }
+    }
+    let mut x = Vector4::zeros();
+    for k in (0..4).rev() {
+        let mut acc = b[k];
+        for j in k + 1..4 {
+            acc -= a[(k, j)] * x[j];
+        }
+        x[k] = acc / a[(k, k)];
+    }
+    Some(x)
 }
 
 #[cfg(test)]

@@ -1,5 +1,8 @@
-//! Trigonometric polynomials a0 + sum_k (a_k cos k x + b_k sin k x) of degree at most 4, and
-//! their conversion to ordinary polynomials by the half-angle substitution t = tan(x/2).
+//! Trigonometric polynomials a0 + sum_k (a_k cos k x + b_k sin k x) of degree at most 4, their
+//! conversion to ordinary polynomials by the half-angle substitution t = tan(x/2), and the
+//! isolation of their real roots directly on the circle ([`Trig::roots`]).
+
+use arrayvec::ArrayVec;
 
 use crate::poly::Coeffs;
 
@@ -31,6 +34,12 @@ impl Trig {
 
     pub fn eval(&self, x: f64) -> f64 {
         let (s1, c1) = x.sin_cos();
+        self.eval_sc(s1, c1)
+    }
+
+    /// The value at x from (sin x, cos x).
+    #[inline]
+    pub fn eval_sc(&self, s1: f64, c1: f64) -> f64 {
         let (mut ck, mut sk) = (1.0, 0.0);
         let mut acc = self.cos[0];
         for k in 1..=MAX_HARMONIC {
@@ -93,6 +102,106 @@ impl Trig {
         r
     }
 
+    /// The derivative d/dx.
+    pub fn derivative(&self) -> Trig {
+        let mut r = Trig::default();
+        for k in 1..=MAX_HARMONIC {
+            r.cos[k] = k as f64 * self.sin[k];
+            r.sin[k] = -(k as f64) * self.cos[k];
+        }
+        r
+    }
+
+    /// sum_k k^order |(a_k, b_k)|: a bound on |d^order p / dx^order| over the circle.
+    fn harmonic_bound(&self, order: i32) -> f64 {
+        let b: f64 = (1..=MAX_HARMONIC)
+            .map(|k| {
+                let (a, b) = (self.cos[k], self.sin[k]);
+                (k as f64).powi(order) * (a * a + b * b).sqrt()
+            })
+            .sum();
+        b * (1.0 + 1e-12)
+    }
+
+    /// |a0| + sum_k (|a_k| + |b_k|), scaled to bound the rounding error of evaluating p (a sum
+    /// of nine products of cosines and sines accurate to a few units in the last place, at a
+    /// point representable to half a unit of pi).
+    fn eval_error(&self) -> f64 {
+        let abs: f64 = self.cos[0].abs()
+            + (1..=MAX_HARMONIC)
+                .map(|k| self.cos[k].abs() + self.sin[k].abs())
+                .sum::<f64>();
+        64.0 * f64::EPSILON * abs
+    }
+
+    /// p at the grid points x_j.
+    fn on_grid(&self) -> [f64; GRID] {
+        let mut v = [self.cos[0]; GRID];
+        for k in 0..MAX_HARMONIC {
+            let (a, b) = (self.cos[k + 1], self.sin[k + 1]);
+            for (j, vj) in v.iter_mut().enumerate() {
+                *vj += a * GRID_COS[k][j] + b * GRID_SIN[k][j];
+            }
+        }
+        v
+    }
+
+    /// Every real root in [-pi, pi], each once (a root at +-pi as -pi), in increasing order;
+    /// at a double root or a pair of roots too close to separate in floating point, one
+    /// candidate. Empty when p is identically zero or not finite.
+    ///
+    /// Complete by construction: F, F', F'' are sampled on a grid of 32 points and every grid
+    /// interval is either proved root-free, proved monotone (its one root, if F changes sign, is
+    /// found by bracketed Newton), proved convex or concave (split at its critical point into two
+    /// monotone pieces), or bisected (see `Isolation::interval`). This replaces the degree-8
+    /// half-angle polynomials of IFToMM 2007 section VI for the forward kinematics (one pass over
+    /// the circle, no chart at alpha = pi, no recursion on derivatives).
+    pub fn roots(&self) -> ArrayVec<f64, MAX_TRIG_ROOTS> {
+        let scale = self
+            .cos
+            .iter()
+            .chain(&self.sin)
+            .fold(0.0f64, |m, a| m.max(a.abs()));
+        if scale == 0.0 || !scale.is_finite() {
+            return ArrayVec::new();
+        }
+        let f = self.scale(1.0 / scale);
+        let d = f.derivative();
+        let s = d.derivative();
+        let mut iso = Isolation {
+            f,
+            d,
+            s,
+            m2: s.harmonic_bound(0),
+            m3: s.harmonic_bound(1),
+            m4: s.harmonic_bound(2),
+            ef: f.eval_error(),
+            ed: d.eval_error(),
+            es: s.eval_error(),
+            out: ArrayVec::new(),
+            orig: *self,
+            charts: [None, None],
+        };
+        let (fv, dv, sv) = (f.on_grid(), d.on_grid(), s.on_grid());
+        let step = std::f64::consts::PI / 16.0;
+        let pt = |j: usize| Pt {
+            x: (j as f64 - 16.0) * step,
+            f: fv[j % GRID],
+            d: dv[j % GRID],
+            s: sv[j % GRID],
+        };
+        for j in 0..GRID {
+            let (a, b) = (pt(j), pt(j + 1));
+            let found = iso.out.len();
+            let near_zero = a.f.abs() <= iso.ef || b.f.abs() <= iso.ef;
+            if near_zero || iso.interval(a, b, 0).is_none() {
+                iso.out.truncate(found);
+                iso.chart_roots(a.x, b.x);
+            }
+        }
+        iso.out
+    }
+
     /// (1 + t^2)^4 p(x) as a polynomial in t = tan((x - shift)/2), shift in {0, pi}: the
     /// half-angle substitution of IFToMM 2007 section VI. With shift = pi the chart covers
     /// x near pi, where t = tan(x/2) would be infinite.
@@ -110,6 +219,318 @@ impl Trig {
         }
         out
     }
+}
+
+/// Most roots [`Trig::roots`] returns: 2 [`MAX_HARMONIC`] simple roots, plus candidates at
+/// near-double roots.
+pub const MAX_TRIG_ROOTS: usize = 32;
+
+/// Grid of the root isolation: x_j = -pi + j pi / 16, j = 0..32.
+const GRID: usize = 32;
+
+/// cos(m pi / 16), m = 0..=8, correctly rounded.
+const COS_OCTANTS: [f64; 9] = [
+    1.0,
+    0.980_785_280_403_230_4,
+    0.923_879_532_511_286_7,
+    0.831_469_612_302_545_2,
+    std::f64::consts::FRAC_1_SQRT_2,
+    0.555_570_233_019_602_2,
+    0.382_683_432_365_089_8,
+    0.195_090_322_016_128_28,
+    0.0,
+];
+
+/// cos(m pi / 16) for any m, by symmetry from the first quadrant (exact table entries).
+const fn grid_cos(m: usize) -> f64 {
+    let m = m % GRID;
+    match m / 8 {
+        0 => COS_OCTANTS[m],
+        1 => -COS_OCTANTS[16 - m],
+        2 => -COS_OCTANTS[m - 16],
+        _ => COS_OCTANTS[32 - m],
+    }
+}
+
+/// cos(k x_j) (`sin == false`) or sin(k x_j) on the grid, k = 1..=4 (row k - 1).
+const fn grid_table(sin: bool) -> [[f64; GRID]; MAX_HARMONIC] {
+    let mut t = [[0.0; GRID]; MAX_HARMONIC];
+    let mut k = 1;
+    while k <= MAX_HARMONIC {
+        let mut j = 0;
+        while j < GRID {
+            // k x_j = (k j - 16 k) pi / 16; sin(y) = cos(y - pi / 2).
+            let m = k * j + 4 * GRID - 16 * k + if sin { 3 * GRID / 4 } else { 0 };
+            t[k - 1][j] = grid_cos(m);
+            j += 1;
+        }
+        k += 1;
+    }
+    t
+}
+
+const GRID_COS: [[f64; GRID]; MAX_HARMONIC] = grid_table(false);
+const GRID_SIN: [[f64; GRID]; MAX_HARMONIC] = grid_table(true);
+
+/// Bisection depth at which an interval that no test decides (a root of multiplicity three or
+/// more, within rounding) is given up and its midpoint reported as a candidate.
+const MAX_DEPTH: u32 = 40;
+
+/// A point with the values of F, F' and F'' there.
+#[derive(Debug, Clone, Copy)]
+struct Pt {
+    x: f64,
+    f: f64,
+    d: f64,
+    s: f64,
+}
+
+/// Both values beyond t on the same side of zero.
+#[inline]
+fn same_sign_beyond(u: f64, v: f64, t: f64) -> bool {
+    u.min(v) > t || u.max(v) < -t
+}
+
+/// Both values beyond t, on opposite sides of zero.
+#[inline]
+fn opposite_beyond(u: f64, v: f64, t: f64) -> bool {
+    u.abs() > t && v.abs() > t && (u < 0.0) != (v < 0.0)
+}
+
+/// Root isolation state for one normalised F (see [`Trig::roots`]).
+struct Isolation {
+    f: Trig,
+    d: Trig,
+    s: Trig,
+    /// Bounds on |F''|, |F'''|, |F''''| over the whole circle.
+    m2: f64,
+    m3: f64,
+    m4: f64,
+    /// Bounds on the rounding errors of evaluating F, F', F''.
+    ef: f64,
+    ed: f64,
+    es: f64,
+    out: ArrayVec<f64, MAX_TRIG_ROOTS>,
+    /// The polynomial as given, and its half-angle charts (computed when needed).
+    orig: Trig,
+    charts: [Option<Coeffs>; 2],
+}
+
+impl Isolation {
+    /// F, F', F'' at x (one sin_cos; cos k x, sin k x by the angle-sum recurrence).
+    #[inline]
+    fn at(&self, x: f64) -> Pt {
+        let (s1, c1) = x.sin_cos();
+        let (c2, s2) = (c1 * c1 - s1 * s1, 2.0 * s1 * c1);
+        let (c3, s3) = (c2 * c1 - s2 * s1, s2 * c1 + c2 * s1);
+        let (c4, s4) = (c2 * c2 - s2 * s2, 2.0 * s2 * c2);
+        let (c, s) = ([c1, c2, c3, c4], [s1, s2, s3, s4]);
+        let dot = |t: &Trig| {
+            let mut acc = t.cos[0];
+            for k in 0..MAX_HARMONIC {
+                acc += t.cos[k + 1] * c[k] + t.sin[k + 1] * s[k];
+            }
+            acc
+        };
+        Pt {
+            x,
+            f: dot(&self.f),
+            d: dot(&self.d),
+            s: dot(&self.s),
+        }
+    }
+
+    fn push(&mut self, x: f64) {
+        if !self.out.is_full() {
+            self.out.push(x);
+        }
+    }
+
+    /// Every root in [a.x, b.x] (F beyond rounding at both ends), or None where F comes within
+    /// rounding of zero inside (a double root or a pair of roots too close for the trigonometric
+    /// form: the caller hands the interval to [`Isolation::chart_roots`]).
+    /// With h = b.x - a.x, a function g with |g''| <= M on the interval stays within h^2 M / 8 of
+    /// its chord: when both end values are beyond that (plus rounding) on the same side of zero,
+    /// g has no zero there. Applied to F (no root), F' (F strictly monotone: one root at most,
+    /// exactly where F changes sign) and F'' (F' strictly monotone: at most one critical point,
+    /// which splits the interval into two monotone pieces). Intervals none of these decides are
+    /// bisected; the bounds shrink four times per bisection, so only the neighbourhood of a triple
+    /// root can reach [`MAX_DEPTH`].
+    fn interval(&mut self, a: Pt, b: Pt, depth: u32) -> Option<()> {
+        let h = b.x - a.x;
+        let w = h * h * 0.125;
+        if same_sign_beyond(a.f, b.f, w * self.m2 + self.ef) {
+            return Some(());
+        }
+        if same_sign_beyond(a.d, b.d, w * self.m3 + self.ed) {
+            self.monotone(a, b);
+            return Some(());
+        }
+        if same_sign_beyond(a.s, b.s, w * self.m4 + self.es) {
+            if opposite_beyond(a.d, b.d, self.ed) {
+                let c = self.critical(a, b);
+                if c.f.abs() <= self.ef {
+                    return None;
+                }
+                self.monotone(a, c);
+                self.monotone(c, b);
+            } else {
+                // F' monotone and not changing sign beyond rounding: F monotone.
+                self.monotone(a, b);
+            }
+            return Some(());
+        }
+        let m = self.at(0.5 * (a.x + b.x));
+        if depth >= MAX_DEPTH || m.f.abs() <= self.ef {
+            return None;
+        }
+        self.interval(a, m, depth + 1)?;
+        self.interval(m, b, depth + 1)
+    }
+
+    /// The roots in [xa, xb] (inside [-pi/2, pi/2] or outside it) from the half-angle chart that
+    /// covers it (IFToMM 2007 section VI), by `poly::roots_in`, whose Horner evaluation near the
+    /// chart's centre (alpha = 0 or pi, where the close pairs of assembly modes occur) is accurate
+    /// relative to the size of F there, not to its coefficients.
+    fn chart_roots(&mut self, xa: f64, xb: f64) {
+        use std::f64::consts::{FRAC_PI_2, PI};
+        let shift = xa < -FRAC_PI_2 || xb > FRAC_PI_2;
+        let k = usize::from(shift);
+        let poly = self.charts[k].get_or_insert_with(|| {
+            let mut poly = self.orig.to_half_angle_poly(shift);
+            let scale = poly.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+            for a in poly.iter_mut() {
+                *a /= scale;
+            }
+            poly
+        });
+        let centre = if !shift {
+            0.0
+        } else if xa < 0.0 {
+            -PI
+        } else {
+            PI
+        };
+        let t = |x: f64| (0.5 * (x - centre)).tan();
+        let (lo, hi) = ((t(xa) - 1e-12).max(-1.0), (t(xb) + 1e-12).min(1.0));
+        for r in crate::poly::roots_in(poly, lo, hi) {
+            let x = 2.0 * r.x.atan() + centre;
+            self.push(x);
+        }
+    }
+
+    /// F monotone on [a.x, b.x]: its root there when F changes sign beyond rounding.
+    fn monotone(&mut self, a: Pt, b: Pt) {
+        if opposite_beyond(a.f, b.f, self.ef) {
+            let start = root_start(a, b);
+            let x = newton_bracketed(a.x, b.x, a.f, start, self.m2, |x| {
+                let p = self.at(x);
+                (p.f, p.d)
+            });
+            self.push(x);
+        }
+    }
+
+    /// The single root of F' on [a.x, b.x] (F' strictly monotone, changing sign), with F there.
+    fn critical(&self, a: Pt, b: Pt) -> Pt {
+        let start = hermite_start(a.x, b.x, a.d, b.d, a.s, b.s);
+        let x = newton_bracketed(a.x, b.x, a.d, start, self.m3, |x| {
+            let p = self.at(x);
+            (p.d, p.s)
+        });
+        self.at(x)
+    }
+}
+
+/// A start for the root of F, monotone on [a.x, b.x] and changing sign there: the inverse
+/// Hermite interpolant when both slopes are usable; next to a critical point (an end where F' is
+/// small, near a double root, where Newton from afar would only halve its distance per step),
+/// the root of the second-order Taylor model of F at that end.
+fn root_start(a: Pt, b: Pt) -> f64 {
+    let h = b.x - a.x;
+    let (e, dir) = if a.d.abs() <= b.d.abs() {
+        (a, 1.0)
+    } else {
+        (b, -1.0)
+    };
+    if e.d.abs() * h < 0.5 * (b.f - a.f).abs() {
+        // F(e.x + dir t) ~ f + dir d t + s t^2 / 2: its smallest positive root.
+        let (q2, q1, q0) = (0.5 * e.s, dir * e.d, e.f);
+        let disc = q1 * q1 - 4.0 * q2 * q0;
+        if disc >= 0.0 {
+            let q = -0.5 * (q1 + q1.signum() * disc.sqrt());
+            let t = [q0 / q, q / q2]
+                .into_iter()
+                .filter(|t| *t > 0.0 && *t < h)
+                .fold(f64::INFINITY, f64::min);
+            if t.is_finite() {
+                return e.x + dir * t;
+            }
+        }
+    }
+    hermite_start(a.x, b.x, a.f, b.f, a.d, b.d)
+}
+
+/// A start for the root of g, monotone on [a, b] with g(a) = ga, g(b) = gb of opposite signs:
+/// the cubic Hermite interpolant of the inverse function x(g) at g = 0 (slopes 1 / g'), or the
+/// secant's root where a slope is unusable.
+fn hermite_start(a: f64, b: f64, ga: f64, gb: f64, da: f64, db: f64) -> f64 {
+    let dy = gb - ga;
+    let t = -ga / dy;
+    let slope = (b - a) / dy;
+    let usable = |d: f64| d != 0.0 && (d > 0.0) == (slope > 0.0);
+    let x = if usable(da) && usable(db) {
+        let (t2, t3) = (t * t, t * t * t);
+        (2.0 * t3 - 3.0 * t2 + 1.0) * a
+            + (t3 - 2.0 * t2 + t) * dy / da
+            + (3.0 * t2 - 2.0 * t3) * b
+            + (t3 - t2) * dy / db
+    } else {
+        a + t * (b - a)
+    };
+    if x > a && x < b { x } else { 0.5 * (a + b) }
+}
+
+/// The single root of g, monotone on [a, b] and changing sign there (g(a) = ga), by Newton steps
+/// kept inside a shrinking bracket (bisection when a step leaves it), from `start`. `m2` bounds
+/// |g''|: a Newton step dx from x leaves an error of at most m2 dx^2 / (2 |g'|), so iteration
+/// stops once that (or the step itself) is below the rounding of x, or the bracket cannot shrink.
+fn newton_bracketed(
+    mut a: f64,
+    mut b: f64,
+    ga: f64,
+    start: f64,
+    m2: f64,
+    eval: impl Fn(f64) -> (f64, f64),
+) -> f64 {
+    let a_neg = ga < 0.0;
+    let mut x = start;
+    for _ in 0..200 {
+        let (g, dg) = eval(x);
+        if g == 0.0 {
+            return x;
+        }
+        if (g < 0.0) == a_neg {
+            a = x;
+        } else {
+            b = x;
+        }
+        let step = g / dg;
+        let next = x - step;
+        if next > a && next < b {
+            let tol = f64::EPSILON * next.abs().max(1e-3);
+            if step.abs() <= tol || m2 * step * step <= tol * 2.0 * dg.abs() {
+                return next;
+            }
+            x = next;
+        } else {
+            x = 0.5 * (a + b);
+        }
+        if b - a <= f64::EPSILON * (a.abs() + b.abs()) {
+            return x;
+        }
+    }
+    x
 }
 
 /// (1+t^2)^4 cos(k x) and (1+t^2)^4 sin(k x) as polynomials in t = tan(x/2): the real and
@@ -191,6 +612,122 @@ mod tests {
                 let rhs = (1.0 + t * t).powi(4) * p.eval(x);
                 assert!((lhs - rhs).abs() < 1e-12 * (1.0 + rhs.abs()), "{lhs} {rhs}");
             }
+        }
+    }
+
+    /// prod_i (cos((p_i - q_i)/2) - cos(x - (p_i + q_i)/2)): roots exactly at every p_i, q_i.
+    fn from_pairs(pairs: &[(f64, f64)]) -> Trig {
+        pairs
+            .iter()
+            .fold(Trig::linear(1.0, 0.0, 0.0), |acc, &(p, q)| {
+                let m = 0.5 * (p + q);
+                acc.mul(&Trig::linear((0.5 * (p - q)).cos(), -m.cos(), -m.sin()))
+            })
+    }
+
+    fn circle_dist(a: f64, b: f64) -> f64 {
+        let d = (a - b).rem_euclid(std::f64::consts::TAU);
+        d.min(std::f64::consts::TAU - d)
+    }
+
+    /// Every expected root is within `tol` of a reported one, and every reported one of an
+    /// expected one.
+    fn assert_roots(p: &Trig, want: &[f64], tol: f64) {
+        let got = p.roots();
+        for &w in want {
+            assert!(
+                got.iter().any(|&g| circle_dist(g, w) < tol),
+                "{w} not in {got:?}"
+            );
+        }
+        for &g in &got {
+            assert!(
+                want.iter().any(|&w| circle_dist(g, w) < tol),
+                "{g} not expected: {want:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn roots_on_the_circle() {
+        let pairs = [(-2.9, -2.0), (-1.1, -0.3), (0.4, 1.2), (2.2, 3.0)];
+        let want: Vec<f64> = pairs.iter().flat_map(|&(p, q)| [p, q]).collect();
+        assert_roots(&from_pairs(&pairs), &want, 1e-12);
+        assert_roots(&from_pairs(&pairs).scale(3.7e21), &want, 1e-12);
+        assert!(Trig::linear(2.0, 1.0, 0.5).roots().is_empty());
+        assert!(Trig::default().roots().is_empty());
+    }
+
+    #[test]
+    fn roots_at_grid_points_and_pi() {
+        use std::f64::consts::{FRAC_PI_2, PI};
+        let step = PI / 16.0;
+        let pairs = [
+            (0.0, FRAC_PI_2),
+            (-FRAC_PI_2, 3.0 * step),
+            (PI, -5.0 * step),
+        ];
+        let want: Vec<f64> = pairs.iter().flat_map(|&(p, q)| [p, q]).collect();
+        assert_roots(&from_pairs(&pairs), &want, 1e-12);
+    }
+
+    #[test]
+    fn close_pairs_are_separated() {
+        use std::f64::consts::PI;
+        for (centre, sep) in [
+            (0.1, 6.7e-5),
+            (1.0, 1e-5),
+            (3.0 * PI / 16.0, 1e-5),
+            (-0.0019, 2e-7),
+            (0.0, 1e-7),
+            (PI - 2e-3, 1e-7),
+            (-PI + 1e-4, 1e-7),
+        ] {
+            let pairs = [
+                (centre - 0.5 * sep, centre + 0.5 * sep),
+                (2.0, -2.5),
+                (1.7, 1.9),
+            ];
+            let want: Vec<f64> = pairs.iter().flat_map(|&(p, q)| [p, q]).collect();
+            // 1 - cos(sep / 2) carries the pair's separation in the coefficients: rounded, it
+            // moves the roots by a few percent of sep; a quarter of sep still tells them apart.
+            assert_roots(&from_pairs(&pairs), &want, 0.25 * sep);
+        }
+    }
+
+    #[test]
+    fn double_root_gives_a_candidate() {
+        for x in [0.3, 0.0, std::f64::consts::PI, -1.2] {
+            let p = from_pairs(&[(x, x), (2.0, -2.5)]);
+            assert_roots(&p, &[x, 2.0, -2.5], 1e-7);
+        }
+    }
+
+    #[test]
+    fn agrees_with_the_half_angle_charts() {
+        let mut state = 0x1234_5678_9abc_def0u64;
+        let mut unit = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        for _ in 0..3000 {
+            let mut p = Trig::default();
+            for k in 0..=MAX_HARMONIC {
+                p.cos[k] = unit();
+                if k > 0 {
+                    p.sin[k] = unit();
+                }
+            }
+            let mut want = Vec::new();
+            for shift in [false, true] {
+                let q = p.to_half_angle_poly(shift);
+                for r in crate::poly::roots_in(&q, -1.0, 1.0) {
+                    want.push(2.0 * r.x.atan() + if shift { std::f64::consts::PI } else { 0.0 });
+                }
+            }
+            assert_roots(&p, &want, 1e-9);
         }
     }
 }
