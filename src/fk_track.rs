@@ -19,7 +19,9 @@ use nalgebra::{Matrix4, Vector4};
 use crate::branches::{WORKING_CONFIG, combine, cos_tilt_max, leg_check};
 use crate::machine::Machine;
 use crate::module_fk::{self, FkMode, FkModes};
-use crate::module_geometry::{ModulePose, Sliders, jacobian_pose, residuals};
+use crate::module_geometry::{
+    ModulePose, Sliders, jacobian_pose, residuals, residuals_jacobian_sin_cos,
+};
 use crate::module_ik::wrap_angle;
 
 /// Chord iterations before a row goes to the complete solution.
@@ -40,6 +42,8 @@ pub struct FkTracker<'m> {
     lipschitz: f64,
     /// The previous row's mode and the inverse Jacobian there.
     last: Option<(FkMode, Matrix4<f64>)>,
+    /// The pose two rows back, when the previous row was tracked from it (for the predictor).
+    before_last: Option<ModulePose>,
     /// Rows answered by tracking and by the complete solution.
     pub tracked: u64,
     pub solved: u64,
@@ -60,6 +64,7 @@ impl<'m> FkTracker<'m> {
             radius,
             lipschitz,
             last: None,
+            before_last: None,
             tracked: 0,
             solved: 0,
         }
@@ -75,6 +80,7 @@ impl<'m> FkTracker<'m> {
             return;
         }
         self.solved += 1;
+        self.before_last = None;
         *out = module_fk::solve(self.machine, rho);
         let g = &self.machine.module;
         self.last = module_fk::working(out).and_then(|w| {
@@ -88,7 +94,14 @@ impl<'m> FkTracker<'m> {
         let g = &self.machine.module;
         let (prev, inv_prev) = self.last.take()?;
         let scaled = |d: &Vector4<f64>| Vector4::new(d[0], d[1], d[2], d[3] * self.radius).norm();
-        let mut pose = prev.pose;
+        // Start from the previous pose, or its linear extrapolation along the path.
+        let mut pose = match self.before_last.take() {
+            Some(b) => ModulePose {
+                p: 2.0 * prev.pose.p - b.p,
+                alpha: 2.0 * prev.pose.alpha - b.alpha,
+            },
+            None => prev.pose,
+        };
         let mut converged = false;
         for _ in 0..MAX_CHORD_STEPS {
             let step = inv_prev * residuals(g, &pose, rho);
@@ -105,7 +118,8 @@ impl<'m> FkTracker<'m> {
         if !converged {
             return None;
         }
-        let inv = jacobian_pose(g, &pose, rho).try_inverse()?;
+        let (_, jac, (s, c)) = residuals_jacobian_sin_cos(g, &pose, rho);
+        let inv = jac.try_inverse()?;
         // beta = |J^-1| in the scaled pose (Frobenius norm, an upper bound of the 2-norm).
         let beta = Matrix4::from_fn(|i, j| {
             if i == 3 {
@@ -126,14 +140,15 @@ impl<'m> FkTracker<'m> {
             return None;
         }
         pose.alpha = wrap_angle(pose.alpha);
-        let mode = self.labelled(&pose, rho)?;
+        let mode = self.labelled(&pose, rho, s, c)?;
         self.last = Some((mode, inv));
+        self.before_last = Some(prev.pose);
         Some(mode)
     }
 
-    /// The mode with its configuration and verdict, when it is the machine's and feasible.
-    fn labelled(&self, pose: &ModulePose, rho: &Sliders) -> Option<FkMode> {
-        let (s, c) = pose.alpha.sin_cos();
+    /// The mode with its configuration and verdict, when it is the machine's and feasible;
+    /// (s, c) = sin, cos of its alpha.
+    fn labelled(&self, pose: &ModulePose, rho: &Sliders, s: f64, c: f64) -> Option<FkMode> {
         let legs: [(i8, _); 3] = std::array::from_fn(|i| {
             leg_check(self.machine, i, &pose.p, s, c, rho[i], self.cos_tilt)
         });

@@ -172,16 +172,27 @@ pub fn polish_pose_with_residual(
 
 /// The residuals of eqs. (3)-(6) and the Jacobian A of [`jacobian_pose`], from one sin_cos.
 #[inline]
-fn residuals_and_jacobian(
+pub(crate) fn residuals_and_jacobian(
     g: &ModuleGeometry,
     pose: &ModulePose,
     rho: &Sliders,
 ) -> (Vector4<f64>, Matrix4<f64>) {
+    let (f, a, _) = residuals_jacobian_sin_cos(g, pose, rho);
+    (f, a)
+}
+
+/// [`residuals_and_jacobian`], with (sin alpha, cos alpha).
+#[inline]
+pub(crate) fn residuals_jacobian_sin_cos(
+    g: &ModuleGeometry,
+    pose: &ModulePose,
+    rho: &Sliders,
+) -> (Vector4<f64>, Matrix4<f64>, (f64, f64)) {
     let (s, c) = pose.alpha.sin_cos();
     let v = rod_vectors_sc(g, pose, rho, s, c);
     let l = rod_lengths(g);
     let f = Vector4::from_fn(|i, _| v[i].norm_squared() - l[i] * l[i]);
-    (f, jacobian_at(&v, g, s, c))
+    (f, jacobian_at(&v, g, s, c), (s, c))
 }
 
 /// a^-1 b by Gaussian elimination with partial pivoting; None when a pivot is zero.

@@ -13,7 +13,7 @@ use crate::error::VerneError;
 use crate::table::{CellError, CsvSource, Sink, encode_field, format_number, parse_number, shown};
 
 /// Input rows read together; bounds memory and amortises thread hand-off.
-pub const BATCH_ROWS: usize = 1024;
+pub const BATCH_ROWS: usize = 4096;
 /// Output rows a batch aims at: a job that writes several rows per input row (`--all`) reads
 /// fewer input rows per batch, so memory stays bounded whatever the input.
 const BATCH_OUTPUT_ROWS: usize = 8 * BATCH_ROWS;
