@@ -98,7 +98,8 @@ fn bracketed(c: &[f64; 4], mut a: f64, mut b: f64, fa: f64, fb: f64) -> Root {
         let step = 2.0 * f * d1 / (2.0 * d1 * d1 - f * d2);
         let next = x - step;
         let tiny = 2.0 * f64::EPSILON * x.abs().max(1e-300);
-        if !(next > a && next < b) || !step.is_finite() {
+        let inside = next > a && next < b && step.is_finite();
+        if !inside {
             // Outside the bracket (or at its end, with f at rounding level): bisect.
             if step.abs() <= tiny {
                 break;
