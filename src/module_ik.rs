@@ -123,8 +123,8 @@ fn leg1_postures(g: &ModuleGeometry, p: &Vector3<f64>) -> ArrayVec<Leg1, 6> {
         for cand in candidates {
             let polished = polish_leg1(g, p, cand);
             let dup = out.iter().any(|o: &Leg1| {
-                angle_diff(o.alpha, polished.alpha).abs() < SAME_SOLUTION_RAD
-                    && (o.rho1 - polished.rho1).abs() < 1e-7
+                (o.rho1 - polished.rho1).abs() < 1e-7
+                    && angle_diff(o.alpha, polished.alpha).abs() < SAME_SOLUTION_RAD
             });
             if !dup && !out.is_full() {
                 out.push(polished);
@@ -180,7 +180,7 @@ fn polish_leg1(g: &ModuleGeometry, p: &Vector3<f64>, start: Leg1) -> Leg1 {
             break;
         }
         let alpha = cur.alpha - step[0];
-        let (sin, cos) = alpha.sin_cos();
+        let (sin, cos) = rotated(cur.sin, cur.cos, alpha, step[0]);
         cur = Leg1 {
             alpha,
             rho1: cur.rho1 - step[1],
@@ -200,6 +200,19 @@ fn polish_leg1(g: &ModuleGeometry, p: &Vector3<f64>, start: Leg1) -> Leg1 {
     with_wrapped_alpha(best.0)
 }
 
+/// sin and cos of `alpha` = a - d from those of a: by the angle-difference formulas with the
+/// series of sin d and cos d (exact in double precision for |d| < 1e-3), else by sin_cos.
+#[inline]
+fn rotated(sin_a: f64, cos_a: f64, alpha: f64, d: f64) -> (f64, f64) {
+    if d.abs() >= 1e-3 {
+        return alpha.sin_cos();
+    }
+    let d2 = d * d;
+    let sd = d * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0));
+    let cd = 1.0 - d2 / 2.0 * (1.0 - d2 / 12.0);
+    (sin_a * cd - cos_a * sd, cos_a * cd + sin_a * sd)
+}
+
 /// The posture with alpha in (-pi, pi] (sin and cos recomputed if it moved).
 fn with_wrapped_alpha(mut l: Leg1) -> Leg1 {
     let wrapped = wrap_angle(l.alpha);
@@ -211,7 +224,11 @@ fn with_wrapped_alpha(mut l: Leg1) -> Leg1 {
 }
 
 /// Angle in (-pi, pi].
+#[inline]
 pub fn wrap_angle(a: f64) -> f64 {
+    if a > -std::f64::consts::PI && a <= std::f64::consts::PI {
+        return a;
+    }
     let tau = std::f64::consts::TAU;
     let mut w = a.rem_euclid(tau);
     if w > std::f64::consts::PI {
