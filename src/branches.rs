@@ -197,7 +197,7 @@ pub fn leg_check(
 
 /// cos of the largest rod tilt with its slack, for [`leg_check`].
 pub fn cos_tilt_max(m: &Machine) -> f64 {
-    (m.limits.rod_tilt_max + LIMIT_SLACK).cos()
+    m.limits.cos_rod_tilt_max
 }
 
 /// The reasons of a whole branch: its legs' and R1 cos(alpha) <= r1 (rods of leg I cross).

@@ -32,6 +32,9 @@ pub struct Limits {
     pub rho_max: [f64; 3],
     /// Largest angle between a rod and the vertical slider axis (rad).
     pub rod_tilt_max: f64,
+    /// cos(rod_tilt_max + LIMIT_SLACK), derived from it when the machine is read: the rod-tilt
+    /// test compares cosines ([`crate::branches::leg_check`]).
+    pub cos_rod_tilt_max: f64,
     pub theta1_min: f64,
     pub theta1_max: f64,
 }
@@ -681,6 +684,7 @@ fn finish(
             rho_min: [v(11), v(13), v(15)],
             rho_max: [v(12), v(14), v(16)],
             rod_tilt_max: v(17).to_radians(),
+            cos_rod_tilt_max: (v(17).to_radians() + crate::tolerance::LIMIT_SLACK).cos(),
             theta1_min: v(18).to_radians(),
             theta1_max: v(19).to_radians(),
         },
