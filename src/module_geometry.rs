@@ -132,8 +132,8 @@ pub fn polish_pose(g: &ModuleGeometry, start: ModulePose, rho: &Sliders) -> Modu
     polish_pose_with_residual(g, start, rho).0
 }
 
-/// [`polish_pose`], with the returned pose's [`residual_mm`]. One sin_cos per Newton step: the
-/// residuals and the Jacobian A at each iterate come from the same rod vectors.
+/// [`polish_pose`], with the returned pose's [`residual_mm`]. One evaluation of the rod vectors
+/// per Newton step gives the residuals and the Jacobian A, from one sin_cos.
 pub fn polish_pose_with_residual(
     g: &ModuleGeometry,
     start: ModulePose,
@@ -143,7 +143,8 @@ pub fn polish_pose_with_residual(
     let l = rod_lengths(g);
     let as_mm = |f: &Vector4<f64>| (0..4).fold(0.0f64, |m, i| m.max((f[i] / (2.0 * l[i])).abs()));
     let mut cur = start;
-    let (mut f, mut a) = residuals_and_jacobian(g, &cur, rho);
+    let (mut s, mut c) = cur.alpha.sin_cos();
+    let (mut f, mut a) = residuals_jacobian_at(g, &cur, rho, s, c);
     let mut res = as_mm(&f);
     let mut best = (cur, res);
     for _ in 0..NEWTON_MAX_ITER {
@@ -158,7 +159,8 @@ pub fn polish_pose_with_residual(
             p: cur.p - Vector3::new(step[0], step[1], step[2]),
             alpha: cur.alpha - step[3],
         };
-        (f, a) = residuals_and_jacobian(g, &cur, rho);
+        (s, c) = cur.alpha.sin_cos();
+        (f, a) = residuals_jacobian_at(g, &cur, rho, s, c);
         res = as_mm(&f);
         if res <= best.1 {
             best = (cur, res);
@@ -170,18 +172,23 @@ pub fn polish_pose_with_residual(
     best
 }
 
-/// The residuals of eqs. (3)-(6) and the Jacobian A of [`jacobian_pose`], from one sin_cos.
+/// Residuals and Jacobian A from the rod vectors at (sin alpha, cos alpha) = (s, c).
 #[inline]
-pub(crate) fn residuals_and_jacobian(
+fn residuals_jacobian_at(
     g: &ModuleGeometry,
     pose: &ModulePose,
     rho: &Sliders,
+    s: f64,
+    c: f64,
 ) -> (Vector4<f64>, Matrix4<f64>) {
-    let (f, a, _) = residuals_jacobian_sin_cos(g, pose, rho);
-    (f, a)
+    let v = rod_vectors_sc(g, pose, rho, s, c);
+    let l = rod_lengths(g);
+    let f = Vector4::from_fn(|i, _| v[i].norm_squared() - l[i] * l[i]);
+    (f, jacobian_at(&v, g, s, c))
 }
 
-/// [`residuals_and_jacobian`], with (sin alpha, cos alpha).
+/// The residuals of eqs. (3)-(6), the Jacobian A of [`jacobian_pose`] and (sin alpha,
+/// cos alpha), from one sin_cos.
 #[inline]
 pub(crate) fn residuals_jacobian_sin_cos(
     g: &ModuleGeometry,

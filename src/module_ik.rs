@@ -14,6 +14,7 @@ use crate::module_geometry::Sliders;
 use crate::tolerance::{
     NEWTON_MAX_ITER, NEWTON_STEP_STOP, SAME_SOLUTION_RAD, SIN_ALPHA_ZERO, SQRT_ARG_REL,
 };
+use crate::trig::sin_cos_after_step;
 
 /// Most branches one point can have: three roots of eq. (9), two alphas each, two rho2, two rho3.
 pub const MAX_IK_BRANCHES: usize = 24;
@@ -180,7 +181,7 @@ fn polish_leg1(g: &ModuleGeometry, p: &Vector3<f64>, start: Leg1) -> Leg1 {
             break;
         }
         let alpha = cur.alpha - step[0];
-        let (sin, cos) = rotated(cur.sin, cur.cos, alpha, step[0]);
+        let (sin, cos) = sin_cos_after_step(cur.sin, cur.cos, alpha, step[0]);
         cur = Leg1 {
             alpha,
             rho1: cur.rho1 - step[1],
@@ -198,19 +199,6 @@ fn polish_leg1(g: &ModuleGeometry, p: &Vector3<f64>, start: Leg1) -> Leg1 {
         }
     }
     with_wrapped_alpha(best.0)
-}
-
-/// sin and cos of `alpha` = a - d from those of a: by the angle-difference formulas with the
-/// series of sin d and cos d (exact in double precision for |d| < 1e-3), else by sin_cos.
-#[inline]
-fn rotated(sin_a: f64, cos_a: f64, alpha: f64, d: f64) -> (f64, f64) {
-    if d.abs() >= 1e-3 {
-        return alpha.sin_cos();
-    }
-    let d2 = d * d;
-    let sd = d * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0));
-    let cd = 1.0 - d2 / 2.0 * (1.0 - d2 / 12.0);
-    (sin_a * cd - cos_a * sd, cos_a * cd + sin_a * sd)
 }
 
 /// The posture with alpha in (-pi, pi] (sin and cos recomputed if it moved).

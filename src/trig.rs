@@ -6,6 +6,20 @@ use arrayvec::ArrayVec;
 
 use crate::poly::Coeffs;
 
+/// sin and cos of `alpha` = a - d from those of a (a Newton step d): by the angle-difference
+/// formulas with the series of sin d and cos d (exact in double precision for |d| < 1e-3),
+/// else by `sin_cos`.
+#[inline]
+pub fn sin_cos_after_step(sin_a: f64, cos_a: f64, alpha: f64, d: f64) -> (f64, f64) {
+    if d.abs() >= 1e-3 {
+        return alpha.sin_cos();
+    }
+    let d2 = d * d;
+    let sd = d * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0));
+    let cd = 1.0 - d2 / 2.0 * (1.0 - d2 / 12.0);
+    (sin_a * cd - cos_a * sd, cos_a * cd + sin_a * sd)
+}
+
 /// Highest harmonic kept.
 pub const MAX_HARMONIC: usize = 4;
 
