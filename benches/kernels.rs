@@ -1,18 +1,21 @@
-//! Criterion benchmarks of the parallel-module kernels (IFToMM 2007, sections V-VI) against the
-//! Newton-Raphson resolution the VERNE controller uses, measured in the same run and reported as
-//! ratios (docs/benchmarks.md; `scripts/bench.sh` runs this and records the table).
+//! Criterion benchmarks of the kinematic kernels of `verne` (IFToMM 2007 sections V-VI for the
+//! parallel module, AIM 2007 sections III-IV for the whole machine) against the Newton-Raphson
+//! resolution the VERNE controller uses, measured in the same run and reported as ratios
+//! (docs/benchmarks.md; `scripts/bench.sh` runs this and records the table).
 //!
-//! Inputs are deterministic: a helix around (-250, 0, 1050) mm sampled at about 0.2 mm per row
-//! (12 m/min at a 1 kHz servo rate), and a scattered set from a fixed LCG for the kernels that do
-//! not depend on row order. Baselines: Newton-Raphson on the four equations (3)-(6) for
-//! (xp, yp, zp, alpha) given the sliders (FK) or for (alpha, rho1, rho2, rho3) given P (IK),
-//! warm-started from the previous row, stopping when every residual, expressed as a length error
-//! along its rod, is below 1e-9 mm, at most 120 iterations (LinuxCNC genhexkins'
-//! HEXKINS_CONV_CRITERION and HEXKINS_ITER_LIMIT).
+//! Inputs are deterministic: a helix of radius 120 mm around x = -250, y = 0 mm rising from
+//! z = 1000 to 1300 mm, sampled at about 0.2 mm per row (12 m/min at a 1 kHz servo rate); a
+//! scattered set from a fixed LCG for the kernels that do not depend on row order; a 5-axis tool
+//! path (a spiral on a dome, the tool normal to the surface, as `examples/make_verify_data.rs`
+//! writes) with the joints the library chooses along it; and a z layer of the `verne workspace`
+//! grids. Baselines: Newton-Raphson on the four equations
+//! (3)-(6) for (xp, yp, zp, alpha) given the sliders (FK) or for (alpha, rho1, rho2, rho3) given
+//! P (IK), warm-started from the previous row, stopping when every residual, expressed as a
+//! length error along its rod, is below 1e-9 mm, at most 120 iterations (LinuxCNC genhexkins'
+//! HEXKINS_CONV_CRITERION and HEXKINS_ITER_LIMIT). The machine, verify and workspace kernels
+//! have no such baseline.
 //!
-//! Also here: a working-mode FK tracker (Newton on (3)-(6) from the previous row's pose, accepted
-//! only when it converges quickly on the machine's configuration, `module_fk::solve` otherwise),
-//! a candidate for the library; and a few sub-kernels that show where the FK time goes.
+//! Also here: a few sub-kernels that show where the module FK and IK time goes.
 //!
 //! `cargo bench --bench kernels` prints a summary table at the end; with `VERNE_BENCH_SUMMARY=FILE`
 //! the table is also written to FILE (markdown).
@@ -20,21 +23,30 @@
 use std::cell::RefCell;
 use std::collections::BTreeMap;
 use std::f64::consts::TAU;
+use std::fmt::Write as _;
 use std::hint::black_box;
+use std::io::Cursor;
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use criterion::{Criterion, Throughput};
 use nalgebra::{Matrix4, Vector3, Vector4};
-use verne::branches::{Config, Reason, Verdict, WORKING_CONFIG, config_of, module_verdict};
+use verne::branches::{Config, config_of, module_verdict};
+use verne::cubic::cubic_roots_in;
+use verne::fk_track::FkTracker;
 use verne::machine::{Machine, ModuleGeometry};
-use verne::module_fk;
+use verne::machine_kin::{FirstRowChoice, PathState, machine_fk, path_candidates};
+use verne::module_fk::{self, FkModes};
 use verne::module_geometry::{
     ModulePose, Sliders, jacobian_pose, jacobian_sliders, polish_pose, residuals,
 };
 use verne::module_ik;
-use verne::poly::roots_in;
-use verne::tolerance::LIMIT_SLACK;
+use verne::orientation::ToolOrientation;
+use verne::pipeline::RUN_ROWS;
+use verne::table::CsvSource;
 use verne::trig::Trig;
+use verne::verify::{JointReader, PathReader, Thresholds, VerifyOptions, verify};
+use verne::workspace::{self, Of, Outcome, PAPER_LAMBDA_BOUNDS, WorkspaceOptions};
 
 // ------------------------------------------------------------------------------ parameters
 
@@ -56,10 +68,24 @@ const NEWTON_TOL_MM: f64 = 1e-9;
 /// Newton baselines: iteration cap (LinuxCNC genhexkins HEXKINS_ITER_LIMIT = 120).
 const NEWTON_ITER_LIMIT: usize = 120;
 
-/// Tracker: Newton steps allowed before the row is handed to `module_fk::solve`.
-const TRACK_MAX_ITER: usize = 4;
-/// Tracker: same stopping rule as the baselines (mm along the rod).
-const TRACK_TOL_MM: f64 = NEWTON_TOL_MM;
+/// Tool path of the machine kernels (workpiece frame R_t): tips on a dome (centre, radius, mm)
+/// along a spiral whose polar angle grows from BETA0 to BETA1 (deg), the tool axis the surface
+/// normal, tips DOME_STEP_MM apart, DOME_FEED_MM_MIN for the `t` column of the joint table
+/// (examples/make_verify_data.rs, at this row count).
+const DOME_ROWS: usize = 1024;
+const DOME_CENTRE: [f64; 3] = [0.0, 0.0, -100.0];
+const DOME_RADIUS_MM: f64 = 150.0;
+const DOME_BETA0_DEG: f64 = 6.0;
+const DOME_BETA1_DEG: f64 = 30.0;
+const DOME_STEP_MM: f64 = 0.5;
+const DOME_FEED_MM_MIN: f64 = 1500.0;
+
+/// Workspace kernels: the z layer nearest WS_LAYER_Z_MM of the default `verne workspace` box
+/// (`--of platform`, `--of tool` with the machine's tool length), on a grid of WS_STEP_MM (the
+/// command's default is 10 mm; a coarser step keeps a layer to about 1,100-1,200 points, and the time
+/// per point does not depend on the step).
+const WS_STEP_MM: f64 = 30.0;
+const WS_LAYER_Z_MM: f64 = 1150.0;
 
 /// Criterion settings: short, so that the whole bench runs in a few minutes on 2 cores.
 const WARM_UP: Duration = Duration::from_millis(800);
@@ -106,7 +132,47 @@ fn scattered(rows: usize) -> Vec<Vector3<f64>> {
         .collect()
 }
 
+/// One intended tool pose of the machine path: tip (mm) and unit tool axis in R_t.
+#[derive(Debug, Clone, Copy)]
+struct ToolPoint {
+    tip: Vector3<f64>,
+    axis: Vector3<f64>,
+}
+
+/// The dome spiral: `rows` tips DOME_STEP_MM apart, the polar angle growing linearly with the
+/// azimuth from DOME_BETA0_DEG to DOME_BETA1_DEG, the axis the outward normal; tips rounded to
+/// 4 decimals and axes to 7, as a CAM system writes them (the joints are those of the values
+/// written).
+fn dome_spiral(rows: usize) -> Vec<ToolPoint> {
+    let (b0, b1) = (DOME_BETA0_DEG.to_radians(), DOME_BETA1_DEG.to_radians());
+    let mean_sin = ((b0.cos() - b1.cos()) / (b1 - b0)).abs();
+    let turns = rows as f64 * DOME_STEP_MM / (TAU * DOME_RADIUS_MM * mean_sin);
+    let dbeta_dpsi = (b1 - b0) / (TAU * turns);
+    let round = |v: f64, d: i32| (v * 10f64.powi(d)).round() / 10f64.powi(d);
+    let centre = Vector3::from(DOME_CENTRE);
+    let mut psi = 0.0f64;
+    (0..rows)
+        .map(|_| {
+            let beta = b0 + dbeta_dpsi * psi;
+            let n = Vector3::new(beta.sin() * psi.cos(), beta.sin() * psi.sin(), beta.cos());
+            let tip = centre + DOME_RADIUS_MM * n;
+            psi +=
+                DOME_STEP_MM / (DOME_RADIUS_MM * (beta.sin().powi(2) + dbeta_dpsi.powi(2)).sqrt());
+            ToolPoint {
+                tip: tip.map(|v| round(v, 4)),
+                axis: n.map(|v| round(v, 7)),
+            }
+        })
+        .collect()
+}
+
 // ------------------------------------------------------- equations (3)-(6), fused evaluation
+//
+// The library has residuals, jacobian_pose and jacobian_sliders as separate public functions,
+// each recomputing the rod vectors and sin_cos(alpha); its fused evaluation is crate-private. A
+// controller evaluates residuals and Jacobian together, so the Newton baselines keep this fused
+// evaluation (one sin_cos per iterate): built from the separate functions they would be slower
+// and the ratios flattering. `Fixture::check_fused_system` ties it to the library's equations.
 
 /// Residuals of (3)-(6) and the partial derivatives a Newton step needs, from one sin_cos.
 struct System {
@@ -116,8 +182,6 @@ struct System {
     v: [Vector3<f64>; 4],
     /// d f / d alpha.
     dfa: Vector4<f64>,
-    /// cos(alpha).
-    cos_alpha: f64,
 }
 
 #[inline(always)]
@@ -145,12 +209,7 @@ fn system(g: &ModuleGeometry, pose: &ModulePose, rho: &Sliders) -> System {
         2.0 * (v[2].y * r2s - v[2].z * r2c),
         2.0 * (-v[3].y * r2s + v[3].z * r2c),
     );
-    System {
-        f,
-        v,
-        dfa,
-        cos_alpha: c,
-    }
+    System { f, v, dfa }
 }
 
 /// |f_i| <= 2 L_i tol for every rod: the length error along each rod is below `tol` (mm).
@@ -263,180 +322,6 @@ fn newton_ik(
     ((alpha, rho), NEWTON_ITER_LIMIT)
 }
 
-// ------------------------------------------------------------ verdict without inverse cosines
-
-/// `module_verdict` with the rod-tilt test done on cosines: tilt = acos(v_z / |v|) > T is
-/// v_z < cos(T) |v| since acos decreases (T <= pi), so no `acos` per rod; the rod vectors are
-/// passed in (a solver has them). Same reasons as `module_verdict` (checked in the fixture).
-#[inline]
-fn verdict_no_acos(
-    m: &Machine,
-    cos_tilt_max: f64,
-    cos_alpha: f64,
-    v: &[Vector3<f64>; 4],
-    rho: &Sliders,
-    config: Config,
-) -> Verdict {
-    let mut out = Verdict::default();
-    let inverted = [
-        Reason::Leg1Inverted,
-        Reason::Leg2Inverted,
-        Reason::Leg3Inverted,
-    ];
-    let stroke = [Reason::Rho1Stroke, Reason::Rho2Stroke, Reason::Rho3Stroke];
-    for i in 0..3 {
-        if config[i] != -1 {
-            out.add(inverted[i]);
-        }
-        if rho[i] < m.limits.rho_min[i] - LIMIT_SLACK || rho[i] > m.limits.rho_max[i] + LIMIT_SLACK
-        {
-            out.add(stroke[i]);
-        }
-    }
-    if m.module.r_big1 * cos_alpha <= m.module.r_small1 {
-        out.add(Reason::RodsCross);
-    }
-    if v.iter().any(|r| r.z < cos_tilt_max * r.norm()) {
-        out.add(Reason::RodTilt);
-    }
-    out
-}
-
-fn cos_tilt_max(m: &Machine) -> f64 {
-    (m.limits.rod_tilt_max + LIMIT_SLACK)
-        .min(std::f64::consts::PI)
-        .cos()
-}
-
-// ----------------------------------------------------------------------------- tracker
-
-/// The machine's assembly mode of one row, as `module_fk::working` would report it.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Tracked {
-    pose: ModulePose,
-    config: Config,
-    verdict: Verdict,
-}
-
-/// How the tracker takes its Newton steps.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Step {
-    /// Full Newton: Jacobian and LU solve at every iterate.
-    Newton,
-    /// Chord: the Jacobian inverse of the previous row's solution, refreshed once per row.
-    Chord,
-}
-
-/// Working-mode FK along a path: Newton on (3)-(6) from the previous row's pose, accepted when it
-/// converges within [`TRACK_MAX_ITER`] steps, keeps the machine's configuration (s1, s2, s3) =
-/// (-1, -1, -1) and R1 cos(alpha) > r1, and passes the machine's verdict; `module_fk::solve` and
-/// `module_fk::working` otherwise (first row, a jump, a limit, a slow convergence).
-struct Tracker<'m> {
-    machine: &'m Machine,
-    limit: Vector4<f64>,
-    step: Step,
-    /// Verdict by `verdict_no_acos` instead of `module_verdict`.
-    fast_verdict: bool,
-    cos_tilt_max: f64,
-    /// The previous row's working pose and the inverse FK Jacobian there.
-    last: Option<(ModulePose, Matrix4<f64>)>,
-    fallbacks: u64,
-    iterations: u64,
-}
-
-impl<'m> Tracker<'m> {
-    fn new(machine: &'m Machine, step: Step, fast_verdict: bool) -> Tracker<'m> {
-        Tracker {
-            machine,
-            limit: residual_limits(&machine.module, TRACK_TOL_MM),
-            step,
-            fast_verdict,
-            cos_tilt_max: cos_tilt_max(machine),
-            last: None,
-            fallbacks: 0,
-            iterations: 0,
-        }
-    }
-
-    #[inline]
-    fn solve(&mut self, rho: &Sliders) -> Option<Tracked> {
-        if let Some(t) = self.track(rho) {
-            return Some(t);
-        }
-        self.fallbacks += 1;
-        let modes = module_fk::solve(self.machine, rho);
-        let w = module_fk::working(&modes).copied();
-        self.last = w.and_then(|w| {
-            jac_pose(&system(&self.machine.module, &w.pose, rho))
-                .try_inverse()
-                .map(|inv| (w.pose, inv))
-        });
-        w.map(|w| Tracked {
-            pose: w.pose,
-            config: w.config,
-            verdict: w.verdict,
-        })
-    }
-
-    #[inline]
-    fn track(&mut self, rho: &Sliders) -> Option<Tracked> {
-        let g = &self.machine.module;
-        let (mut pose, inv) = self.last?;
-        let mut done = None;
-        for it in 0..=TRACK_MAX_ITER {
-            let sys = system(g, &pose, rho);
-            if converged(&sys.f, &self.limit) {
-                done = Some((sys, it));
-                break;
-            }
-            if it == TRACK_MAX_ITER {
-                break;
-            }
-            let step = match self.step {
-                Step::Newton => jac_pose(&sys).lu().solve(&sys.f)?,
-                Step::Chord => inv * sys.f,
-            };
-            pose.p -= step.xyz();
-            pose.alpha -= step[3];
-        }
-        let (sys, it) = done?;
-        self.iterations += it as u64;
-        // Same configuration as the machine's mode, rods of leg I not crossing (section V).
-        if g.r_big1 * sys.cos_alpha <= g.r_small1 {
-            return None;
-        }
-        let config = config_of(g, &pose, rho);
-        if config != WORKING_CONFIG {
-            return None;
-        }
-        let verdict = if self.fast_verdict {
-            verdict_no_acos(
-                self.machine,
-                self.cos_tilt_max,
-                sys.cos_alpha,
-                &sys.v,
-                rho,
-                config,
-            )
-        } else {
-            module_verdict(self.machine, &pose, rho, config)
-        };
-        if !verdict.feasible() {
-            return None;
-        }
-        let inv = match self.step {
-            Step::Newton => inv,
-            Step::Chord => jac_pose(&sys).try_inverse()?,
-        };
-        self.last = Some((pose, inv));
-        Some(Tracked {
-            pose,
-            config,
-            verdict,
-        })
-    }
-}
-
 // ------------------------------------------- sub-kernels: where the forward kinematics spends
 
 /// The characteristic trigonometric polynomial F(alpha) of `module_fk` (its module
@@ -487,6 +372,14 @@ fn ik_cubic(g: &ModuleGeometry, p: &Vector3<f64>) -> [f64; 4] {
 
 // --------------------------------------------------------------------------- fixture
 
+/// Joints of one machine row: sliders (mm), theta1, theta2 (rad).
+#[derive(Debug, Clone, Copy)]
+struct MachineJoints {
+    rho: Sliders,
+    theta1: f64,
+    theta2: f64,
+}
+
 struct Fixture {
     machine: Machine,
     limit: Vector4<f64>,
@@ -498,6 +391,17 @@ struct Fixture {
     scatter: Vec<Vector3<f64>>,
     /// Joints of the scattered points that have a working branch.
     scatter_joints: Vec<Sliders>,
+    /// The machine's tool path (dome spiral) and, for its rows where `PathState` found a
+    /// working branch, the tool point and the joints chosen.
+    tool_path: Vec<ToolPoint>,
+    tool_joints: Vec<(ToolPoint, MachineJoints)>,
+    /// `verne verify` inputs made from `tool_joints`: the intended path (id,x,y,z,i,j,k) and the
+    /// joint table (id,t,rho1,rho2,rho3,theta1,theta2 in mm, s, degrees with 6 decimals).
+    verify_path_csv: Arc<[u8]>,
+    verify_joints_csv: Arc<[u8]>,
+    verify_options: VerifyOptions,
+    /// Workspace kernels: options and the grid layer, per `Of::Platform` and `Of::Tool`.
+    ws: Vec<(WorkspaceOptions, Vec<Vector3<f64>>)>,
 }
 
 impl Fixture {
@@ -525,6 +429,88 @@ impl Fixture {
             .iter()
             .filter_map(|p| module_ik::working(&module_ik::solve(&machine, p)).map(|w| w.rho))
             .collect();
+
+        // The machine path and the joints the library chooses along it (`verne machine ik`).
+        let tool_path = dome_spiral(DOME_ROWS);
+        let tl = machine.tool_length;
+        let mut state = PathState::new(FirstRowChoice::SmallestTheta1);
+        let tool_joints: Vec<(ToolPoint, MachineJoints)> = tool_path
+            .iter()
+            .filter_map(|t| {
+                let row = state
+                    .next_row(&machine, &t.tip, &ToolOrientation::Axis(t.axis), tl)
+                    .ok()?;
+                Some((
+                    *t,
+                    MachineJoints {
+                        rho: row.rho,
+                        theta1: row.theta1,
+                        theta2: row.theta2,
+                    },
+                ))
+            })
+            .collect();
+        let dt = DOME_STEP_MM / (DOME_FEED_MM_MIN / 60.0);
+        let (mut path_csv, mut joints_csv) = (
+            String::from("id,x,y,z,i,j,k\n"),
+            String::from("id,t,rho1,rho2,rho3,theta1,theta2\n"),
+        );
+        for (k, (t, q)) in tool_joints.iter().enumerate() {
+            let _ = writeln!(
+                path_csv,
+                "{},{:.4},{:.4},{:.4},{:.7},{:.7},{:.7}",
+                k + 1,
+                t.tip.x,
+                t.tip.y,
+                t.tip.z,
+                t.axis.x,
+                t.axis.y,
+                t.axis.z
+            );
+            let _ = writeln!(
+                joints_csv,
+                "{},{:.4},{:.6},{:.6},{:.6},{:.6},{:.6}",
+                k + 1,
+                k as f64 * dt,
+                q.rho.x,
+                q.rho.y,
+                q.rho.z,
+                q.theta1.to_degrees(),
+                q.theta2.to_degrees()
+            );
+        }
+        let verify_options = VerifyOptions {
+            thresholds: Thresholds::from_machine(&machine, "<default>")
+                .expect("the default machine's verify thresholds are valid"),
+            tool_length: tl,
+        };
+
+        // One z layer of the default `verne workspace` grids.
+        let ws = [(Of::Platform, 0.0), (Of::Tool, tl)]
+            .into_iter()
+            .map(|(of, tool_length)| {
+                let opts = WorkspaceOptions {
+                    of,
+                    tool_length,
+                    step: WS_STEP_MM,
+                    bounds: None,
+                    lambda: PAPER_LAMBDA_BOUNDS,
+                };
+                let grid = workspace::grid_for(&machine, &opts).expect("workspace grid");
+                let k = (0..grid.n[2])
+                    .min_by(|&a, &b| {
+                        (grid.coord(2, a) - WS_LAYER_Z_MM)
+                            .abs()
+                            .total_cmp(&(grid.coord(2, b) - WS_LAYER_Z_MM).abs())
+                    })
+                    .expect("non-empty grid");
+                let layer = (0..grid.n[1])
+                    .flat_map(|j| (0..grid.n[0]).map(move |i| grid.point(i, j, k)))
+                    .collect();
+                (opts, layer)
+            })
+            .collect();
+
         let fx = Fixture {
             machine,
             limit,
@@ -533,6 +519,12 @@ impl Fixture {
             path_poses,
             scatter,
             scatter_joints,
+            tool_path,
+            tool_joints,
+            verify_path_csv: path_csv.into_bytes().into(),
+            verify_joints_csv: joints_csv.into_bytes().into(),
+            verify_options,
+            ws,
         };
         fx.check_fused_system();
         fx
@@ -624,18 +616,97 @@ impl Fixture {
         (acc, iters)
     }
 
-    fn run_tracker(&self, step: Step, fast: bool, rhos: &[Sliders]) -> (f64, Tracker<'_>) {
-        let mut t = Tracker::new(&self.machine, step, fast);
-        let mut acc = 0.0;
-        for rho in rhos {
-            if let Some(w) = t.solve(black_box(rho)) {
-                acc += w.pose.p.x;
+    /// The working mode along rows `rhos` by the library's tracker, a fresh tracker per run of
+    /// `RUN_ROWS` rows as `verne fk` does (`ModuleFk::solve_run`); calls `each` per row.
+    fn run_tracker(
+        &self,
+        rhos: &[Sliders],
+        mut each: impl FnMut(&Sliders, &FkModes),
+    ) -> (u64, u64) {
+        let mut modes = FkModes::new();
+        let (mut tracked, mut solved) = (0, 0);
+        for run in rhos.chunks(RUN_ROWS) {
+            let mut t = FkTracker::new(&self.machine);
+            for rho in run {
+                t.working_into(black_box(rho), &mut modes);
+                each(rho, &modes);
             }
+            tracked += t.tracked;
+            solved += t.solved;
         }
-        (acc, t)
+        (tracked, solved)
     }
 
-    /// Accuracy and behaviour of the tracker and the baselines, printed before timing.
+    /// Every branch of every tool pose of the machine path, over both orientation solutions of
+    /// the axis (what `verne machine ik` solves per row before choosing).
+    fn run_machine_ik(&self) -> usize {
+        let tl = self.machine.tool_length;
+        self.tool_path
+            .iter()
+            .map(|t| {
+                path_candidates(
+                    &self.machine,
+                    black_box(&t.tip),
+                    &ToolOrientation::Axis(t.axis),
+                    tl,
+                    None,
+                )
+                .map_or(0, |c| c.len())
+            })
+            .sum()
+    }
+
+    /// Every assembly mode of the machine for the joints chosen along the path.
+    fn run_machine_fk(&self) -> usize {
+        let tl = self.machine.tool_length;
+        self.tool_joints
+            .iter()
+            .map(|(_, q)| {
+                machine_fk(&self.machine, black_box(&q.rho), q.theta1, q.theta2, tl).len()
+            })
+            .sum()
+    }
+
+    /// `verne verify` of the joint table against the path, from in-memory CSV (the API reads
+    /// `CsvSource`s), findings counted instead of written. Returns (rows, findings).
+    fn run_verify(&self) -> (u64, u64) {
+        let src = |bytes: &Arc<[u8]>, name: &str| {
+            CsvSource::from_reader(Box::new(Cursor::new(Arc::clone(bytes))), name)
+                .expect("in-memory CSV")
+        };
+        let mut joints = JointReader::new(src(&self.verify_joints_csv, "joints")).expect("joints");
+        let mut path = PathReader::from_csv(src(&self.verify_path_csv, "path")).expect("path");
+        let mut findings = 0u64;
+        let summary = verify(
+            &self.machine,
+            &self.verify_options,
+            &mut joints,
+            &mut path,
+            &mut |_| {
+                findings += 1;
+                Ok(())
+            },
+        )
+        .expect("verify");
+        (summary.rows, findings)
+    }
+
+    /// Classifies every point of workspace layer `w` (0: platform, 1: tool).
+    fn run_workspace(&self, w: usize) -> [usize; 3] {
+        let (opts, layer) = &self.ws[w];
+        let mut n = [0usize; 3];
+        for q in layer {
+            let r = workspace::classify(&self.machine, opts, black_box(q));
+            n[match r.outcome {
+                Outcome::Inside => 0,
+                Outcome::Bound(_) => 1,
+                Outcome::OutOfReach => 2,
+            }] += 1;
+        }
+        n
+    }
+
+    /// Accuracy and behaviour of the tracker, the baselines and the inputs, printed before timing.
     fn accuracy_report(&self) -> Vec<String> {
         let g = &self.machine.module;
         let mut lines = Vec::new();
@@ -644,62 +715,29 @@ impl Fixture {
             ("path", &path_rho),
             ("scattered (no continuity)", &self.scatter_joints),
         ] {
-            for (step, fast) in [
-                (Step::Newton, false),
-                (Step::Chord, false),
-                (Step::Chord, true),
-            ] {
-                let mut t = Tracker::new(&self.machine, step, fast);
-                let (mut dp, mut da, mut mismatch) = (0.0f64, 0.0f64, 0usize);
-                for rho in rhos.iter() {
-                    let got = t.solve(rho);
-                    let want = module_fk::working(&module_fk::solve(&self.machine, rho)).copied();
-                    match (got, want) {
-                        (Some(a), Some(b)) => {
-                            dp = dp.max((a.pose.p - b.pose.p).amax());
-                            da = da.max((a.pose.alpha - b.pose.alpha).abs());
-                            if a.config != b.config || a.verdict != b.verdict {
-                                mismatch += 1;
-                            }
+            let (mut dp, mut da, mut mismatch) = (0.0f64, 0.0f64, 0usize);
+            let (tracked, solved) = self.run_tracker(rhos, |rho, modes| {
+                let got = module_fk::working(modes);
+                let full = module_fk::solve(&self.machine, rho);
+                match (got, module_fk::working(&full)) {
+                    (Some(a), Some(b)) => {
+                        dp = dp.max((a.pose.p - b.pose.p).amax());
+                        da = da.max((a.pose.alpha - b.pose.alpha).abs());
+                        if a.config != b.config || a.verdict != b.verdict {
+                            mismatch += 1;
                         }
-                        (None, None) => {}
-                        _ => mismatch += 1,
                     }
+                    (None, None) => {}
+                    _ => mismatch += 1,
                 }
-                let tracked = rhos.len() as u64 - t.fallbacks;
-                let verdict = if fast { ", verdict_no_acos" } else { "" };
-                lines.push(format!(
-                    "tracker ({step:?}{verdict}) on {label}: {} rows, {} fallbacks to module_fk::solve, \
-                     {:.2} steps per tracked row; vs module_fk::working: max |dP| {:.1e} mm, \
-                     max |d alpha| {:.1e} rad, {} mismatched rows",
-                    rhos.len(),
-                    t.fallbacks,
-                    t.iterations as f64 / tracked.max(1) as f64,
-                    dp,
-                    da,
-                    mismatch
-                ));
-            }
+            });
+            lines.push(format!(
+                "fk_track::FkTracker on {label}: {} rows in runs of {RUN_ROWS}, {tracked} tracked, \
+                 {solved} solved by module_fk::solve; vs module_fk::working(module_fk::solve): \
+                 max |dP| {dp:.1e} mm, max |d alpha| {da:.1e} rad, {mismatch} mismatched rows",
+                rhos.len(),
+            ));
         }
-        let ct = cos_tilt_max(&self.machine);
-        let (mut checked, mut differ) = (0usize, 0usize);
-        for p in self.path.iter().chain(&self.scatter) {
-            for b in module_ik::solve(&self.machine, p) {
-                let pose = ModulePose {
-                    p: *p,
-                    alpha: b.alpha,
-                };
-                let sys = system(g, &pose, &b.rho);
-                let v = verdict_no_acos(&self.machine, ct, sys.cos_alpha, &sys.v, &b.rho, b.config);
-                checked += 1;
-                if v != b.verdict {
-                    differ += 1;
-                }
-            }
-        }
-        lines.push(format!(
-            "verdict_no_acos vs module_verdict: {checked} IK branches (path + scattered), {differ} differ"
-        ));
         let (_, it_fk) = self.run_newton_fk();
         let (_, it_ik) = self.run_newton_ik();
         // Baseline accuracy against the exact solutions.
@@ -729,16 +767,82 @@ impl Fixture {
         ));
         let modes: usize = self.run_fk_all(path_rho.iter().copied());
         let branches: usize = self.run_ik_all(&self.path);
+        let fast = |pts: &[Vector3<f64>]| {
+            pts.iter()
+                .filter(|p| module_ik::working_fast(&self.machine, p).is_some())
+                .count()
+        };
         lines.push(format!(
             "path: {} rows, step {:.3} mm per row; {:.2} IK branches and {:.2} FK modes per row; \
-             scattered: {} points, {} with a working branch",
+             scattered: {} points, {} with a working branch; module_ik::solve_working_into took \
+             the fast path (working_fast) on {} path rows and {} scattered points",
             self.path.len(),
             (self.path[1] - self.path[0]).norm(),
             branches as f64 / self.path.len() as f64,
             modes as f64 / self.path.len() as f64,
             self.scatter.len(),
-            self.scatter_joints.len()
+            self.scatter_joints.len(),
+            fast(&self.path),
+            fast(&self.scatter),
         ));
+
+        // Machine path: reachability, branches, and FK of the chosen joints back to the path.
+        let tl = self.machine.tool_length;
+        let (mut reachable, mut working) = (0usize, 0usize);
+        for t in &self.tool_path {
+            if let Ok(c) = path_candidates(
+                &self.machine,
+                &t.tip,
+                &ToolOrientation::Axis(t.axis),
+                tl,
+                None,
+            ) {
+                reachable += usize::from(!c.is_empty());
+                working += usize::from(c.iter().any(|(b, _, _)| b.working()));
+            }
+        }
+        let (mut tip_err, mut axis_err, mut no_mode) = (0.0f64, 0.0f64, 0usize);
+        for (t, q) in &self.tool_joints {
+            let modes = machine_fk(&self.machine, &q.rho, q.theta1, q.theta2, tl);
+            let w = modes
+                .iter()
+                .filter(|m| m.working())
+                .min_by(|a, b| a.module.alpha.abs().total_cmp(&b.module.alpha.abs()));
+            match w {
+                Some(w) => {
+                    tip_err = tip_err.max((w.tool.tip - t.tip).amax());
+                    axis_err = axis_err.max((w.axis - t.axis.normalize()).amax());
+                }
+                None => no_mode += 1,
+            }
+        }
+        lines.push(format!(
+            "machine path (dome spiral, R = {DOME_RADIUS_MM} mm, tool tilted {DOME_BETA0_DEG} to \
+             {DOME_BETA1_DEG} deg, {DOME_STEP_MM} mm per row, tool length {tl} mm): {} tool poses, \
+             {reachable} with a real branch, {working} with a working branch; {:.2} branches per \
+             pose (both orientation solutions); {:.2} machine FK modes per row; FK of the chosen \
+             joints vs the path: max |dU| {tip_err:.1e} mm, max |d axis| {axis_err:.1e}, \
+             {no_mode} rows without a working mode",
+            self.tool_path.len(),
+            self.run_machine_ik() as f64 / self.tool_path.len() as f64,
+            self.run_machine_fk() as f64 / self.tool_joints.len().max(1) as f64,
+        ));
+        let (rows, findings) = self.run_verify();
+        lines.push(format!(
+            "verify: {rows} joint rows (machine path, joints of PathState written with 6 \
+             decimals) against the path, {findings} findings; timed on a 1-thread rayon pool, \
+             CSV parsing of both in-memory tables included"
+        ));
+        for (w, (opts, layer)) in self.ws.iter().enumerate() {
+            let [inside, bound, out] = self.run_workspace(w);
+            lines.push(format!(
+                "workspace --of {}: z = {} mm layer of the default box at {WS_STEP_MM} mm: {} \
+                 points, {inside} inside, {bound} outside by a constraint, {out} out of reach",
+                opts.of.name(),
+                layer.first().map_or(f64::NAN, |q| q.z),
+                layer.len(),
+            ));
+        }
         lines
     }
 }
@@ -787,48 +891,80 @@ where
     g.finish();
 }
 
-/// (kernel, baseline, target text): the pairs reported as ratios.
-const RATIOS: &[(&str, &str, &str)] = &[
+/// (kernel, what one input is, baseline or "" for none, target text): the main table, with
+/// ratios to the baseline measured in the same run.
+const KERNELS: &[(&str, &str, &str, &str)] = &[
     (
         "ik/working_branch",
+        "module pose",
         "ik/newton_warm",
         "< 100 ns/pose and <= 0.5x Newton IK",
     ),
     (
         "ik/all_branches",
+        "module pose",
         "ik/newton_warm",
         "< 250 ns/pose (all sixteen branches)",
     ),
     (
         "ik/working_branch_scattered",
+        "module pose",
         "ik/newton_warm",
         "(no continuity; Newton needs it)",
     ),
-    ("fk/all_modes", "fk/newton_warm", "< 2 us/pose"),
+    (
+        "fk/all_modes",
+        "slider row",
+        "fk/newton_warm",
+        "< 2 us/pose",
+    ),
     (
         "fk/all_modes_scattered",
+        "slider row",
         "fk/newton_warm",
         "(no continuity; Newton needs it)",
     ),
     (
         "fk/working_solve",
+        "slider row",
         "fk/newton_warm",
         "(solve + working on every row, no tracking)",
     ),
     (
-        "fk/working_track_newton",
+        "fk/working_track",
+        "slider row",
         "fk/newton_warm",
         "<= 1.0x warm-started Newton FK",
     ),
     (
-        "fk/working_track_chord",
-        "fk/newton_warm",
-        "<= 1.0x warm-started Newton FK",
+        "machine/ik_all_branches",
+        "tool pose",
+        "",
+        "tip + axis -> every branch, both orientation solutions (path_candidates)",
     ),
     (
-        "fk/working_track_chord_fast_verdict",
-        "fk/newton_warm",
-        "<= 1.0x warm-started Newton FK",
+        "machine/fk_all_modes",
+        "joint row",
+        "",
+        "joints -> every assembly mode and its tool pose (machine_fk)",
+    ),
+    (
+        "verify/row",
+        "joint row",
+        "",
+        "verne verify per row: CSV parse, row and segment checks, 1 thread",
+    ),
+    (
+        "workspace/platform_point",
+        "grid point",
+        "",
+        "workspace::classify, --of platform",
+    ),
+    (
+        "workspace/tool_point",
+        "grid point",
+        "",
+        "workspace::classify, --of tool (tool length of the machine)",
     ),
 ];
 
@@ -848,31 +984,32 @@ const PARTS: &[(&str, &str)] = &[
     ),
     (
         "parts/module_verdict",
-        "module_verdict (4 acos in rod_tilts), per call (IK: 16 per row)",
-    ),
-    (
-        "parts/verdict_no_acos",
-        "the same verdict tested on cosines (rod vectors given), per call",
+        "module_verdict (squared rod tilts, no acos), per call",
     ),
     ("parts/config_of", "config_of, per call"),
     (
         "parts/ik_cubic_roots_in",
-        "roots_in on the cubic (9), per row",
+        "cubic_roots_in on the cubic (9) over [-1, 1], per row",
     ),
 ];
 
 fn summary(rec: &Record, accuracy: &[String]) -> String {
     let mut s = String::new();
-    s.push_str("| kernel | ns/pose | baseline | baseline ns/pose | ratio | target |\n");
-    s.push_str("|---|---:|---|---:|---:|---|\n");
-    for (k, b, target) in RATIOS {
-        let (Some(tk), Some(tb)) = (rec.median_ns(k), rec.median_ns(b)) else {
+    s.push_str("| kernel | input | ns/input | baseline | baseline ns/input | ratio | target |\n");
+    s.push_str("|---|---|---:|---|---:|---:|---|\n");
+    for (k, input, b, target) in KERNELS {
+        let Some(tk) = rec.median_ns(k) else {
             continue;
         };
-        s.push_str(&format!(
-            "| `{k}` | {tk:.0} | `{b}` | {tb:.0} | {:.2} | {target} |\n",
-            tk / tb
-        ));
+        match rec.median_ns(b) {
+            Some(tb) => s.push_str(&format!(
+                "| `{k}` | {input} | {tk:.0} | `{b}` | {tb:.0} | {:.2} | {target} |\n",
+                tk / tb
+            )),
+            None => s.push_str(&format!(
+                "| `{k}` | {input} | {tk:.0} | - | - | - | {target} |\n"
+            )),
+        }
     }
     let mut parts = String::new();
     for (k, what) in PARTS {
@@ -929,20 +1066,47 @@ fn main() {
         fx.run_fk_working()
     });
     bench(&mut c, &rec, "fk", "newton_warm", n, || fx.run_newton_fk());
-    bench(&mut c, &rec, "fk", "working_track_newton", n, || {
-        fx.run_tracker(Step::Newton, false, &path_rho).0
+    bench(&mut c, &rec, "fk", "working_track", n, || {
+        let mut acc = 0.0;
+        fx.run_tracker(&path_rho, |_, modes| {
+            if let Some(w) = module_fk::working(modes) {
+                acc += w.pose.p.x;
+            }
+        });
+        acc
     });
-    bench(&mut c, &rec, "fk", "working_track_chord", n, || {
-        fx.run_tracker(Step::Chord, false, &path_rho).0
-    });
+
+    // The whole machine, verify, workspace.
     bench(
         &mut c,
         &rec,
-        "fk",
-        "working_track_chord_fast_verdict",
-        n,
-        || fx.run_tracker(Step::Chord, true, &path_rho).0,
+        "machine",
+        "ik_all_branches",
+        fx.tool_path.len(),
+        || fx.run_machine_ik(),
     );
+    bench(
+        &mut c,
+        &rec,
+        "machine",
+        "fk_all_modes",
+        fx.tool_joints.len(),
+        || fx.run_machine_fk(),
+    );
+    // verify solves its batches with rayon: one thread, so that the time per row is the work
+    // per row (and does not depend on what else runs on the machine's cores).
+    let one_thread = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("rayon pool");
+    bench(&mut c, &rec, "verify", "row", fx.tool_joints.len(), || {
+        one_thread.install(|| fx.run_verify())
+    });
+    for (w, name) in [(0, "platform_point"), (1, "tool_point")] {
+        bench(&mut c, &rec, "workspace", name, fx.ws[w].1.len(), || {
+            fx.run_workspace(w)
+        });
+    }
 
     // Sub-kernels.
     bench(&mut c, &rec, "parts", "fk_characteristic", n, || {
@@ -979,24 +1143,6 @@ fn main() {
             .filter(|((p, r), cfg)| module_verdict(&fx.machine, black_box(p), r, **cfg).feasible())
             .count()
     });
-    let ct = cos_tilt_max(&fx.machine);
-    let systems: Vec<System> = fx
-        .path_poses
-        .iter()
-        .zip(&path_rho)
-        .map(|(p, r)| system(&g, p, r))
-        .collect();
-    bench(&mut c, &rec, "parts", "verdict_no_acos", n, || {
-        systems
-            .iter()
-            .zip(&path_rho)
-            .zip(&configs)
-            .filter(|((sys, r), cfg)| {
-                verdict_no_acos(&fx.machine, ct, sys.cos_alpha, black_box(&sys.v), r, **cfg)
-                    .feasible()
-            })
-            .count()
-    });
     bench(&mut c, &rec, "parts", "config_of", n, || {
         fx.path_poses
             .iter()
@@ -1008,7 +1154,7 @@ fn main() {
     bench(&mut c, &rec, "parts", "ik_cubic_roots_in", n, || {
         cubics
             .iter()
-            .map(|c| roots_in(black_box(c), -1.0, 1.0).len())
+            .map(|c| cubic_roots_in(black_box(c), -1.0, 1.0).len())
             .sum::<usize>()
     });
 
