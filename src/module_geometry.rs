@@ -133,7 +133,9 @@ pub fn polish_pose(g: &ModuleGeometry, start: ModulePose, rho: &Sliders) -> Modu
 }
 
 /// [`polish_pose`], with the returned pose's [`residual_mm`]. One evaluation of the rod vectors
-/// per Newton step gives the residuals and the Jacobian A, from one sin_cos.
+/// per Newton step gives the residuals and the Jacobian A, from one sin_cos. A step below
+/// [`FINAL_STEP_MM`] ends it without a further evaluation; the residual returned is then the
+/// one before that step (an upper bound in Newton's quadratic regime).
 pub fn polish_pose_with_residual(
     g: &ModuleGeometry,
     start: ModulePose,
@@ -143,7 +145,7 @@ pub fn polish_pose_with_residual(
     let l = rod_lengths(g);
     let as_mm = |f: &Vector4<f64>| (0..4).fold(0.0f64, |m, i| m.max((f[i] / (2.0 * l[i])).abs()));
     let mut cur = start;
-    let (mut s, mut c) = cur.alpha.sin_cos();
+    let (s, c) = cur.alpha.sin_cos();
     let (mut f, mut a) = residuals_jacobian_at(g, &cur, rho, s, c);
     let mut res = as_mm(&f);
     let mut best = (cur, res);
@@ -159,7 +161,15 @@ pub fn polish_pose_with_residual(
             p: cur.p - Vector3::new(step[0], step[1], step[2]),
             alpha: cur.alpha - step[3],
         };
-        (s, c) = cur.alpha.sin_cos();
+        let size = step
+            .xyz()
+            .amax()
+            .max((step[3] * g.r_big1.max(g.r_big2)).abs());
+        if size < FINAL_STEP_MM {
+            // What such a step leaves is of the order of its square: no need to evaluate.
+            return (cur, res);
+        }
+        let (s, c) = cur.alpha.sin_cos();
         (f, a) = residuals_jacobian_at(g, &cur, rho, s, c);
         res = as_mm(&f);
         if res <= best.1 {
@@ -171,6 +181,9 @@ pub fn polish_pose_with_residual(
     }
     best
 }
+
+/// A Newton step of the pose below this (mm; alpha times the platform radius) is the last.
+pub const FINAL_STEP_MM: f64 = 1e-9;
 
 /// Residuals and Jacobian A from the rod vectors at (sin alpha, cos alpha) = (s, c).
 #[inline]

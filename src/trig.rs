@@ -335,6 +335,23 @@ impl Isolation {
     #[inline]
     fn at(&self, x: f64) -> Pt {
         let (s1, c1) = x.sin_cos();
+        self.at_sc(x, s1, c1)
+    }
+
+    /// [`Isolation::at`] along a Newton iteration: sin and cos of x from those of the previous
+    /// point when it is close ([`sin_cos_after_step`]), kept in `last`.
+    #[inline]
+    fn at_following(&self, x: f64, last: &std::cell::Cell<Option<(f64, f64, f64)>>) -> Pt {
+        let (s1, c1) = match last.get() {
+            Some((x0, s0, c0)) => sin_cos_after_step(s0, c0, x, x0 - x),
+            None => x.sin_cos(),
+        };
+        last.set(Some((x, s1, c1)));
+        self.at_sc(x, s1, c1)
+    }
+
+    #[inline]
+    fn at_sc(&self, x: f64, s1: f64, c1: f64) -> Pt {
         let (c2, s2) = (c1 * c1 - s1 * s1, 2.0 * s1 * c1);
         let (c3, s3) = (c2 * c1 - s2 * s1, s2 * c1 + c2 * s1);
         let (c4, s4) = (c2 * c2 - s2 * s2, 2.0 * s2 * c2);
@@ -437,8 +454,9 @@ impl Isolation {
     fn monotone(&mut self, a: Pt, b: Pt) {
         if opposite_beyond(a.f, b.f, self.ef) {
             let start = root_start(a, b);
+            let last = std::cell::Cell::new(None);
             let x = newton_bracketed(a.x, b.x, a.f, start, self.m2, |x| {
-                let p = self.at(x);
+                let p = self.at_following(x, &last);
                 (p.f, p.d)
             });
             self.push(x);
@@ -448,11 +466,12 @@ impl Isolation {
     /// The single root of F' on [a.x, b.x] (F' strictly monotone, changing sign), with F there.
     fn critical(&self, a: Pt, b: Pt) -> Pt {
         let start = hermite_start(a.x, b.x, a.d, b.d, a.s, b.s);
+        let last = std::cell::Cell::new(None);
         let x = newton_bracketed(a.x, b.x, a.d, start, self.m3, |x| {
-            let p = self.at(x);
+            let p = self.at_following(x, &last);
             (p.d, p.s)
         });
-        self.at(x)
+        self.at_following(x, &last)
     }
 }
 
