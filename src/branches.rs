@@ -210,6 +210,24 @@ pub fn combine(m: &Machine, c: f64, legs: [Verdict; 3]) -> Verdict {
     v
 }
 
+/// Configuration and verdict of a pose of the module with slider positions `rho`, from
+/// (s, c) = sin, cos of its alpha: [`config_of`] and [`module_verdict`] in one pass over the legs.
+#[inline]
+pub fn label(
+    m: &Machine,
+    p: &nalgebra::Vector3<f64>,
+    s: f64,
+    c: f64,
+    rho: &Sliders,
+) -> (Config, Verdict) {
+    let ct = cos_tilt_max(m);
+    let legs: [(i8, Verdict); 3] = std::array::from_fn(|i| leg_check(m, i, p, s, c, rho[i], ct));
+    (
+        [legs[0].0, legs[1].0, legs[2].0],
+        combine(m, c, [legs[0].1, legs[1].1, legs[2].1]),
+    )
+}
+
 /// The verdict of a parallel-module branch: configuration, rod crossing (section V), slider
 /// strokes and rod tilts from the machine file. `config` is as given by [`config_of`].
 pub fn module_verdict(m: &Machine, pose: &ModulePose, rho: &Sliders, config: Config) -> Verdict {

@@ -16,7 +16,7 @@
 
 use nalgebra::{Matrix4, Vector4};
 
-use crate::branches::{WORKING_CONFIG, combine, cos_tilt_max, leg_check};
+use crate::branches::{WORKING_CONFIG, label};
 use crate::machine::Machine;
 use crate::module_fk::{self, FkMode, FkModes};
 use crate::module_geometry::{
@@ -35,7 +35,6 @@ const CERTIFIED_FRACTION: f64 = 0.25;
 /// Follows the working mode from row to row; one per run of consecutive rows.
 pub struct FkTracker<'m> {
     machine: &'m Machine,
-    cos_tilt: f64,
     /// Length by which alpha is scaled, so that pose differences are in mm.
     radius: f64,
     /// Lipschitz constant of the Jacobian in the scaled pose (mm^2 / mm^2 per mm).
@@ -60,7 +59,6 @@ impl<'m> FkTracker<'m> {
         let lipschitz = 4.0 * (3.0 + lmax / radius);
         FkTracker {
             machine,
-            cos_tilt: cos_tilt_max(machine),
             radius,
             lipschitz,
             last: None,
@@ -149,11 +147,7 @@ impl<'m> FkTracker<'m> {
     /// The mode with its configuration and verdict, when it is the machine's and feasible;
     /// (s, c) = sin, cos of its alpha.
     fn labelled(&self, pose: &ModulePose, rho: &Sliders, s: f64, c: f64) -> Option<FkMode> {
-        let legs: [(i8, _); 3] = std::array::from_fn(|i| {
-            leg_check(self.machine, i, &pose.p, s, c, rho[i], self.cos_tilt)
-        });
-        let config = [legs[0].0, legs[1].0, legs[2].0];
-        let verdict = combine(self.machine, c, [legs[0].1, legs[1].1, legs[2].1]);
+        let (config, verdict) = label(self.machine, &pose.p, s, c, rho);
         (config == WORKING_CONFIG && verdict.feasible()).then_some(FkMode {
             pose: *pose,
             config,

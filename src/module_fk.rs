@@ -28,9 +28,9 @@
 use arrayvec::ArrayVec;
 use nalgebra::{Matrix3, Vector3};
 
-use crate::branches::{Config, Verdict, config_of, module_verdict};
+use crate::branches::{Config, Verdict, label};
 use crate::machine::{Machine, ModuleGeometry};
-use crate::module_geometry::{ModulePose, Sliders, polish_pose_with_residual, residual_mm};
+use crate::module_geometry::{ModulePose, Sliders, polish_pose_from, residual_mm};
 use crate::module_ik::wrap_angle;
 use crate::tolerance::{ACCEPT_RESIDUAL_MM, FK_DET_REL, SAME_SOLUTION_MM, SAME_SOLUTION_RAD};
 use crate::trig::Trig;
@@ -114,9 +114,15 @@ impl Elimination {
             .add(&inner.scale(4.0 * self.delta * self.delta))
     }
 
-    /// The pose at `alpha` from the linear solution, or None where Det ~ 0.
-    fn back_substitute(&self, g: &ModuleGeometry, rho: &Sliders, alpha: f64) -> Option<ModulePose> {
-        let (s, c) = alpha.sin_cos();
+    /// The pose at `alpha` from the linear solution, or None where Det ~ 0; (s, c) = sin, cos of
+    /// alpha.
+    fn back_substitute(
+        &self,
+        g: &ModuleGeometry,
+        rho: &Sliders,
+        alpha: f64,
+        (s, c): (f64, f64),
+    ) -> Option<ModulePose> {
         let det = self.det.eval_sc(s, c);
         let det_scale = self.det.cos[0].abs() + self.det.cos[1].abs() + self.det.sin[1].abs();
         if det.abs() <= FK_DET_REL * det_scale || det_scale == 0.0 {
@@ -230,11 +236,13 @@ pub fn solve(m: &Machine, rho: &Sliders) -> FkModes {
     }
     let elim = Elimination::new(g, rho);
     let f = elim.characteristic(g);
-    let mut starts: ArrayVec<ModulePose, 68> = ArrayVec::new();
+    // Starting poses, each with (sin alpha, cos alpha).
+    let mut starts: ArrayVec<(ModulePose, (f64, f64)), 68> = ArrayVec::new();
     for alpha in f.roots() {
-        match elim.back_substitute(g, rho, alpha) {
-            Some(p) => starts.push(p),
-            None => starts.extend(fixed_alpha_points(g, rho, alpha)),
+        let sc = alpha.sin_cos();
+        match elim.back_substitute(g, rho, alpha, sc) {
+            Some(p) => starts.push((p, sc)),
+            None => starts.extend(fixed_alpha_points(g, rho, alpha).into_iter().map(|p| (p, sc))),
         }
     }
     // Where condition (21) fails (Det = 0), a real solution forces b = 0 there and F then has
@@ -249,13 +257,15 @@ pub fn solve(m: &Machine, rho: &Sliders) -> FkModes {
         if elim.b.eval(alpha).abs() > DET_ZERO_B_REL * b_scale {
             continue;
         }
+        let sc = alpha.sin_cos();
         let on_spheres = fixed_alpha_points(g, rho, alpha)
             .into_iter()
-            .filter(|p| residual_mm(g, p, rho) <= ACCEPT_RESIDUAL_MM);
+            .filter(|p| residual_mm(g, p, rho) <= ACCEPT_RESIDUAL_MM)
+            .map(|p| (p, sc));
         starts.extend(on_spheres);
     }
-    for start in starts {
-        let (pose, residual) = polish_pose_with_residual(g, start, rho);
+    for (start, sc) in starts {
+        let (pose, residual) = polish_pose_from(g, start, sc, rho);
         if residual > ACCEPT_RESIDUAL_MM {
             continue;
         }
@@ -270,8 +280,8 @@ pub fn solve(m: &Machine, rho: &Sliders) -> FkModes {
         if dup || out.is_full() {
             continue;
         }
-        let config = config_of(g, &pose, rho);
-        let verdict = module_verdict(m, &pose, rho, config);
+        let (s, c) = pose.alpha.sin_cos();
+        let (config, verdict) = label(m, &pose.p, s, c, rho);
         out.push(FkMode {
             pose,
             config,

@@ -141,11 +141,20 @@ pub fn polish_pose_with_residual(
     start: ModulePose,
     rho: &Sliders,
 ) -> (ModulePose, f64) {
+    polish_pose_from(g, start, start.alpha.sin_cos(), rho)
+}
+
+/// [`polish_pose_with_residual`] from a start whose (sin alpha, cos alpha) are known.
+pub fn polish_pose_from(
+    g: &ModuleGeometry,
+    start: ModulePose,
+    (s, c): (f64, f64),
+    rho: &Sliders,
+) -> (ModulePose, f64) {
     use crate::tolerance::{NEWTON_MAX_ITER, NEWTON_STEP_STOP};
     let l = rod_lengths(g);
     let as_mm = |f: &Vector4<f64>| (0..4).fold(0.0f64, |m, i| m.max((f[i] / (2.0 * l[i])).abs()));
     let mut cur = start;
-    let (s, c) = cur.alpha.sin_cos();
     let (mut f, mut a) = residuals_jacobian_at(g, &cur, rho, s, c);
     let mut res = as_mm(&f);
     let mut best = (cur, res);
