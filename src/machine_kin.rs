@@ -251,7 +251,7 @@ fn theta1_roots(f: &Trig) -> ArrayVec<(f64, bool), 32> {
         for a in poly.iter_mut() {
             *a /= scale;
         }
-        for root in roots_in(&poly, -1.0, 1.0) {
+        for root in &roots_in(&poly, -1.0, 1.0) {
             let th = 2.0 * root.x.atan() + if shift { PI } else { 0.0 };
             if !out.is_full() {
                 out.push((wrap_angle(th), root.touching));

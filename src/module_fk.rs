@@ -238,11 +238,15 @@ pub fn solve(m: &Machine, rho: &Sliders) -> FkModes {
     let f = elim.characteristic(g);
     // Starting poses, each with (sin alpha, cos alpha).
     let mut starts: ArrayVec<(ModulePose, (f64, f64)), 68> = ArrayVec::new();
-    for alpha in f.roots() {
+    for &alpha in &f.roots() {
         let sc = alpha.sin_cos();
         match elim.back_substitute(g, rho, alpha, sc) {
             Some(p) => starts.push((p, sc)),
-            None => starts.extend(fixed_alpha_points(g, rho, alpha).into_iter().map(|p| (p, sc))),
+            None => starts.extend(
+                fixed_alpha_points(g, rho, alpha)
+                    .into_iter()
+                    .map(|p| (p, sc)),
+            ),
         }
     }
     // Where condition (21) fails (Det = 0), a real solution forces b = 0 there and F then has
@@ -264,7 +268,7 @@ pub fn solve(m: &Machine, rho: &Sliders) -> FkModes {
             .map(|p| (p, sc));
         starts.extend(on_spheres);
     }
-    for (start, sc) in starts {
+    for &(start, sc) in &starts {
         let (pose, residual) = polish_pose_from(g, start, sc, rho);
         if residual > ACCEPT_RESIDUAL_MM {
             continue;

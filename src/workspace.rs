@@ -608,12 +608,12 @@ fn mul<const A: usize, const B: usize, const C: usize>(a: &[f64; A], b: &[f64; B
 /// [-1, 1], and 1/t in [-1, 1]).
 fn coupling_roots(c: &[f64; 7]) -> arrayvec::ArrayVec<f64, 24> {
     let mut out = arrayvec::ArrayVec::<f64, 24>::new();
-    for r in roots_in(c, -1.0, 1.0) {
+    for r in &roots_in(c, -1.0, 1.0) {
         out.push(2.0 * r.x.atan());
     }
     let mut rev = *c;
     rev.reverse();
-    for r in roots_in(&rev, -1.0, 1.0) {
+    for r in &roots_in(&rev, -1.0, 1.0) {
         if r.x != 0.0 && r.x.abs() < 1.0 && !out.is_full() {
             out.push(wrap_angle(2.0 * (1.0 / r.x).atan()));
         }
