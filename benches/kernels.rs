@@ -322,54 +322,6 @@ fn newton_ik(
     ((alpha, rho), NEWTON_ITER_LIMIT)
 }
 
-// ------------------------------------------- sub-kernels: where the forward kinematics spends
-
-/// The characteristic trigonometric polynomial F(alpha) of `module_fk` (its module
-/// documentation), rebuilt here from the public `Trig` type so that its cost and the cost of
-/// isolating its roots can be timed separately. Not used for results.
-fn fk_characteristic(g: &ModuleGeometry, rho: &Sliders) -> Trig {
-    let (r, rr, r2, r4) = (g.r_big1, g.r_small1, g.r_big2, g.r4);
-    let p2 = rho.y - rho.x;
-    let p3 = rho.z - rho.x;
-    let delta = g.dx2 - g.dx1;
-    let k0 = g.l1 * g.l1 - r * r - rr * rr;
-    let b = Trig::linear(
-        g.l3 * g.l3 - g.l2 * g.l2 + (p2 + p3) * (p2 - p3),
-        0.0,
-        2.0 * r2 * (p2 + p3),
-    );
-    let det = Trig::linear(
-        -2.0 * rr * (p2 - p3),
-        2.0 * r * (p2 - p3),
-        4.0 * (r * r4 - rr * r2),
-    );
-    let a = Trig::linear(
-        g.l2 * g.l2 - k0 - delta * delta - r2 * r2 - r4 * r4 - p2 * p2,
-        2.0 * r2 * r4 - 2.0 * r * rr,
-        -2.0 * r2 * p2,
-    );
-    let q = Trig::linear(-rr * p2, r * p2, r * r4 - rr * r2);
-    let u_num = a.mul(&det).add(&b.mul(&q).scale(2.0));
-    let n1 = Trig::linear(r * r + rr * rr, -2.0 * r * rr, 0.0);
-    let k1 = Trig::linear(k0, 2.0 * r * rr, 0.0);
-    let inner = b.mul(&b).mul(&n1).add(&k1.mul(&det.mul(&det)).scale(-1.0));
-    u_num.mul(&u_num).add(&inner.scale(4.0 * delta * delta))
-}
-
-/// The cubic (9) in cos(alpha), normalised as `module_ik` does.
-fn ik_cubic(g: &ModuleGeometry, p: &Vector3<f64>) -> [f64; 4] {
-    let (r, rr) = (g.r_big1, g.r_small1);
-    let u = p.x + g.dx1;
-    let y = p.y;
-    let k0 = g.l1 * g.l1 - r * r - rr * rr;
-    let p1 = 2.0 * r * r * r * rr;
-    let p2 = r * r * k0 - r * r * u * u;
-    let p3 = -2.0 * r * r * r * rr - 2.0 * r * rr * y * y;
-    let p4 = r * r * u * u + (r * r + rr * rr) * y * y - r * r * k0;
-    let scale = p1.abs().max(p2.abs()).max(p3.abs()).max(p4.abs());
-    [p4 / scale, p3 / scale, p2 / scale, p1 / scale]
-}
-
 // --------------------------------------------------------------------------- fixture
 
 /// Joints of one machine row: sliders (mm), theta1, theta2 (rad).
@@ -1112,10 +1064,13 @@ fn main() {
     bench(&mut c, &rec, "parts", "fk_characteristic", n, || {
         path_rho
             .iter()
-            .map(|r| fk_characteristic(&g, black_box(r)).cos[0])
+            .map(|r| module_fk::characteristic(&g, black_box(r)).cos[0])
             .sum::<f64>()
     });
-    let chars: Vec<Trig> = path_rho.iter().map(|r| fk_characteristic(&g, r)).collect();
+    let chars: Vec<Trig> = path_rho
+        .iter()
+        .map(|r| module_fk::characteristic(&g, r))
+        .collect();
     bench(&mut c, &rec, "parts", "fk_trig_roots", n, || {
         chars
             .iter()
@@ -1150,7 +1105,11 @@ fn main() {
             .map(|(p, r)| config_of(&g, black_box(p), r)[0] as i64)
             .sum::<i64>()
     });
-    let cubics: Vec<[f64; 4]> = fx.path.iter().map(|p| ik_cubic(&g, p)).collect();
+    let cubics: Vec<[f64; 4]> = fx
+        .path
+        .iter()
+        .filter_map(|p| module_ik::cubic_eq9(&g, p))
+        .collect();
     bench(&mut c, &rec, "parts", "ik_cubic_roots_in", n, || {
         cubics
             .iter()

@@ -139,6 +139,12 @@ impl Elimination {
     }
 }
 
+/// The characteristic trigonometric polynomial F(alpha) of the module documentation for the
+/// slider positions (its real roots are the assembly modes' angles).
+pub fn characteristic(g: &ModuleGeometry, rho: &Sliders) -> Trig {
+    Elimination::new(g, rho).characteristic(g)
+}
+
 /// Points P on all four spheres of eqs. (3)-(6) at a fixed alpha: three sphere differences are
 /// planes; a unique point when they meet in one, and up to two points when they share a line
 /// (the degenerate case of condition (21)).

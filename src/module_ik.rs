@@ -47,7 +47,7 @@ struct Leg1 {
 
 /// The cubic eq. (9) in cos(alpha) for the point, normalised, lowest degree first; None when it
 /// is degenerate (every coefficient zero or not finite).
-fn cubic_eq9(g: &ModuleGeometry, p: &Vector3<f64>) -> Option<[f64; 4]> {
+pub fn cubic_eq9(g: &ModuleGeometry, p: &Vector3<f64>) -> Option<[f64; 4]> {
     let (r, rr) = (g.r_big1, g.r_small1);
     let u = p.x + g.dx1;
     let y = p.y;

@@ -13,6 +13,26 @@ fn temp_dir(tag: &str) -> std::path::PathBuf {
     d
 }
 
+/// stdout of `verne ARGS` fed `input` on stdin (written from another thread, so a large input
+/// cannot deadlock against a full stdout pipe), optionally with RAYON_NUM_THREADS set.
+fn piped(args: &[&str], input: &str, threads: Option<&str>) -> Vec<u8> {
+    let mut cmd = Command::new(BIN);
+    cmd.args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null());
+    if let Some(t) = threads {
+        cmd.env("RAYON_NUM_THREADS", t);
+    }
+    let mut child = cmd.spawn().unwrap();
+    let mut stdin = child.stdin.take().unwrap();
+    let text = input.to_string();
+    let writer = std::thread::spawn(move || stdin.write_all(text.as_bytes()));
+    let out = child.wait_with_output().unwrap();
+    writer.join().unwrap().unwrap();
+    out.stdout
+}
+
 /// A module path of `n` rows inside the workspace.
 fn path_csv(n: usize) -> String {
     let mut s = String::from("xp,yp,zp\n");
@@ -159,19 +179,7 @@ fn every_input_row_yields_one_output_row() {
     }
     for all in [false, true] {
         let args: &[&str] = if all { &["ik", "--all"] } else { &["ik"] };
-        let mut child = Command::new(BIN)
-            .args(args)
-            .stdin(Stdio::piped())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::null())
-            .spawn()
-            .unwrap();
-        let mut stdin = child.stdin.take().unwrap();
-        let text = s.clone();
-        let writer = std::thread::spawn(move || stdin.write_all(text.as_bytes()));
-        let out = child.wait_with_output().unwrap();
-        writer.join().unwrap().unwrap();
-        let text = String::from_utf8(out.stdout).unwrap();
+        let text = String::from_utf8(piped(args, &s, None)).unwrap();
         let ids: Vec<usize> = text
             .lines()
             .skip(1)
@@ -192,22 +200,7 @@ fn every_input_row_yields_one_output_row() {
 /// so `verne fk`'s tracking restarts at the same rows whatever the pool.
 #[test]
 fn output_is_the_same_with_one_and_two_threads() {
-    let run = |args: &[&str], input: &str, threads: &str| {
-        let mut child = Command::new(BIN)
-            .args(args)
-            .env("RAYON_NUM_THREADS", threads)
-            .stdin(Stdio::piped())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::null())
-            .spawn()
-            .unwrap();
-        let mut stdin = child.stdin.take().unwrap();
-        let text = input.to_string();
-        let writer = std::thread::spawn(move || stdin.write_all(text.as_bytes()));
-        let out = child.wait_with_output().unwrap();
-        writer.join().unwrap().unwrap();
-        out.stdout
-    };
+    let run = |args: &[&str], input: &str, threads: &str| piped(args, input, Some(threads));
     let path = path_csv(5000);
     let joints = run(&["ik"], &path, "2");
     assert_eq!(joints, run(&["ik"], &path, "1"));
