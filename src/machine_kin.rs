@@ -32,7 +32,7 @@ use std::f64::consts::PI;
 use arrayvec::ArrayVec;
 use nalgebra::{Matrix2, Matrix4, Vector2, Vector3, Vector4};
 
-use crate::branches::{Config, Reason, Verdict, config_of, module_verdict};
+use crate::branches::{Config, Reason, Verdict, label};
 use crate::machine::{Machine, TableGeometry};
 use crate::module_geometry::{ModulePose, Sliders, residual_mm};
 use crate::module_ik::{leg_sliders, wrap_angle};
@@ -410,8 +410,7 @@ pub fn machine_ik(m: &Machine, pose: &ToolPose, tool_length: f64) -> MachineIkBr
                 if residual_mm(g, &module, &rho) > ACCEPT_RESIDUAL_MM {
                     continue;
                 }
-                let config = config_of(g, &module, &rho);
-                let mut verdict = module_verdict(m, &module, &rho, config);
+                let (config, mut verdict) = label(m, &p, sa, ca, &rho);
                 if !theta1_in_limits(m, theta1) {
                     verdict.add(Reason::Theta1Range);
                 }
