@@ -9,32 +9,35 @@ use crate::module_rows::{ModuleFk, ModuleIk};
 use crate::pipeline::{self, Units};
 use crate::table::{CsvSource, Sink};
 
-/// CSV rows through the module inverse (`fk == false`) or forward kinematics, every branch.
+/// CSV rows through the module inverse (`fk == false`) or forward kinematics, every branch
+/// (`--all`) and the working one (the IK fast path, the FK tracker).
 pub fn csv_rows(data: &[u8], fk: bool) {
-    let Ok(mut source) = CsvSource::from_reader(Box::new(Cursor::new(data.to_vec())), "fuzz")
-    else {
-        return;
-    };
-    let mut sink = Sink::from_writer(Box::new(std::io::sink()), "sink");
-    let machine = Machine::default_verne();
-    let units = Units::default();
-    let _ = if fk {
-        pipeline::run(
-            &mut ModuleFk { machine, all: true },
-            &mut source,
-            &mut sink,
-            units,
-            &|_| {},
-        )
-    } else {
-        pipeline::run(
-            &mut ModuleIk { machine, all: true },
-            &mut source,
-            &mut sink,
-            units,
-            &|_| {},
-        )
-    };
+    for all in [true, false] {
+        let Ok(mut source) = CsvSource::from_reader(Box::new(Cursor::new(data.to_vec())), "fuzz")
+        else {
+            return;
+        };
+        let mut sink = Sink::from_writer(Box::new(std::io::sink()), "sink");
+        let machine = Machine::default_verne();
+        let units = Units::default();
+        let _ = if fk {
+            pipeline::run(
+                &mut ModuleFk { machine, all },
+                &mut source,
+                &mut sink,
+                units,
+                &|_| {},
+            )
+        } else {
+            pipeline::run(
+                &mut ModuleIk { machine, all },
+                &mut source,
+                &mut sink,
+                units,
+                &|_| {},
+            )
+        };
+    }
 }
 
 /// A machine file, TOML or key,value CSV.
