@@ -520,9 +520,15 @@ impl Fixture {
         acc
     }
 
+    /// Every branch into one reused list (`module_ik::solve_into`, as `verne ik --all` does; the
+    /// by-value `solve` adds a copy of the 24-entry list).
     fn run_ik_all(&self, pts: &[Vector3<f64>]) -> usize {
+        let mut b = module_ik::IkBranches::new();
         pts.iter()
-            .map(|p| module_ik::solve(&self.machine, black_box(p)).len())
+            .map(|p| {
+                module_ik::solve_into(&self.machine, black_box(p), &mut b);
+                b.len()
+            })
             .sum()
     }
 
