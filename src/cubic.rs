@@ -7,7 +7,7 @@
 
 use arrayvec::ArrayVec;
 
-use crate::poly::{Root, eval_with_error, roots_in};
+use crate::poly::{Root, eval_with_error, push_unique, roots_in};
 
 /// The roots on one interval: at most three, plus critical points reported as touching.
 pub type CubicRoots = ArrayVec<Root, 8>;
@@ -48,9 +48,9 @@ pub fn cubic_roots_in(c: &[f64; 4], lo: f64, hi: f64) -> CubicRoots {
         let (fb, eb) = eval_with_error(c, xb);
         let b_zero = fb.abs() <= eb;
         if fa.abs() > ea && !b_zero && (fa < 0.0) != (fb < 0.0) {
-            push(&mut out, bracketed(c, xa, xb, fa, fb));
+            push_unique(&mut out, bracketed(c, xa, xb, fa, fb));
         } else if b_zero {
-            push(
+            push_unique(
                 &mut out,
                 Root {
                     x: xb,
@@ -61,16 +61,6 @@ pub fn cubic_roots_in(c: &[f64; 4], lo: f64, hi: f64) -> CubicRoots {
         (xa, fa, ea) = (xb, fb, eb);
     }
     out
-}
-
-fn push(out: &mut CubicRoots, r: Root) {
-    if let Some(last) = out.last_mut()
-        && (r.x - last.x).abs() <= 4.0 * f64::EPSILON * (1.0 + r.x.abs())
-    {
-        last.touching &= r.touching;
-        return;
-    }
-    let _ = out.try_push(r);
 }
 
 /// The root of a cubic that is monotone on [a, b] with p(a), p(b) of opposite signs: Halley

@@ -218,10 +218,8 @@ pub(crate) fn residuals_jacobian_sin_cos(
     rho: &Sliders,
 ) -> (Vector4<f64>, Matrix4<f64>, (f64, f64)) {
     let (s, c) = pose.alpha.sin_cos();
-    let v = rod_vectors_sc(g, pose, rho, s, c);
-    let l = rod_lengths(g);
-    let f = Vector4::from_fn(|i, _| v[i].norm_squared() - l[i] * l[i]);
-    (f, jacobian_at(&v, g, s, c), (s, c))
+    let (f, a) = residuals_jacobian_at(g, pose, rho, s, c);
+    (f, a, (s, c))
 }
 
 /// a^-1 b by Gaussian elimination with partial pivoting; None when a pivot is zero.

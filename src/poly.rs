@@ -115,16 +115,16 @@ pub fn roots_in(c: &[f64], lo: f64, hi: f64) -> Roots {
     out
 }
 
-fn push_unique(out: &mut Roots, r: Root) {
+/// Appends a root to a sorted list, merging it with the last one when they coincide to rounding
+/// (a root found both as a piece's end and as a critical point); a full list keeps what it has.
+pub(crate) fn push_unique<const N: usize>(out: &mut ArrayVec<Root, N>, r: Root) {
     if let Some(last) = out.last_mut()
         && (r.x - last.x).abs() <= 4.0 * f64::EPSILON * (1.0 + r.x.abs())
     {
         last.touching &= r.touching;
         return;
     }
-    if !out.is_full() {
-        out.push(r);
-    }
+    let _ = out.try_push(r);
 }
 
 /// The single root of a polynomial that is monotone on [a, b] with a sign change there:
