@@ -34,6 +34,7 @@ use nalgebra::{Matrix4, Vector3, Vector4};
 use verne::branches::{Config, config_of, module_verdict};
 use verne::cubic::cubic_roots_in;
 use verne::fk_track::FkTracker;
+use verne::ik_track::IkTracker;
 use verne::machine::{Machine, ModuleGeometry};
 use verne::machine_kin::{FirstRowChoice, PathState, machine_fk, path_candidates};
 use verne::module_fk::{self, FkModes};
@@ -595,6 +596,27 @@ impl Fixture {
         (tracked, solved)
     }
 
+    /// The IK working branch along `pts` in runs of RUN_ROWS with [`IkTracker`] (as `verne ik`
+    /// does); `each` sees every row's answer.
+    fn run_ik_tracker(
+        &self,
+        pts: &[Vector3<f64>],
+        mut each: impl FnMut(&Vector3<f64>, &module_ik::IkBranches),
+    ) -> (u64, u64) {
+        let mut b = module_ik::IkBranches::new();
+        let (mut tracked, mut solved) = (0, 0);
+        for run in pts.chunks(RUN_ROWS) {
+            let mut t = IkTracker::new(&self.machine);
+            for p in run {
+                t.working_into(black_box(p), &mut b);
+                each(p, &b);
+            }
+            tracked += t.tracked;
+            solved += t.solved;
+        }
+        (tracked, solved)
+    }
+
     /// Every branch of every tool pose of the machine path, over both orientation solutions of
     /// the axis (what `verne machine ik` solves per row before choosing).
     fn run_machine_ik(&self) -> usize {
@@ -694,6 +716,32 @@ impl Fixture {
                  {solved} solved by module_fk::solve; vs module_fk::working(module_fk::solve): \
                  max |dP| {dp:.1e} mm, max |d alpha| {da:.1e} rad, {mismatch} mismatched rows",
                 rhos.len(),
+            ));
+        }
+        for (label, pts) in [
+            ("path", &self.path),
+            ("scattered (no continuity)", &self.scatter),
+        ] {
+            let (mut dr, mut da, mut mismatch) = (0.0f64, 0.0f64, 0usize);
+            let (tracked, solved) = self.run_ik_tracker(pts, |p, got| {
+                let full = module_ik::solve(&self.machine, p);
+                match (module_ik::working(got), module_ik::working(&full)) {
+                    (Some(a), Some(b)) => {
+                        dr = dr.max((a.rho - b.rho).amax());
+                        da = da.max((a.alpha - b.alpha).abs());
+                        if a.config != b.config || a.verdict != b.verdict {
+                            mismatch += 1;
+                        }
+                    }
+                    (None, None) => {}
+                    _ => mismatch += 1,
+                }
+            });
+            lines.push(format!(
+                "ik_track::IkTracker on {label}: {} rows in runs of {RUN_ROWS}, {tracked} tracked, \
+                 {solved} by module_ik::solve_working_into; vs module_ik::working(module_ik::solve): \
+                 max |d rho| {dr:.1e} mm, max |d alpha| {da:.1e} rad, {mismatch} mismatched rows",
+                pts.len(),
             ));
         }
         let (_, it_fk) = self.run_newton_fk();
@@ -856,7 +904,13 @@ const KERNELS: &[(&str, &str, &str, &str)] = &[
         "ik/working_branch",
         "module pose",
         "ik/newton_warm",
-        "< 100 ns/pose and <= 0.5x Newton IK",
+        "< 100 ns/pose and <= 0.5x Newton IK (each point alone)",
+    ),
+    (
+        "ik/working_track",
+        "module pose",
+        "ik/newton_warm",
+        "< 100 ns/pose and <= 0.5x Newton IK (along the path, as `verne ik`)",
     ),
     (
         "ik/all_branches",
@@ -1010,6 +1064,15 @@ fn main() {
     });
     bench(&mut c, &rec, "ik", "working_branch_scattered", n, || {
         fx.run_ik_working(&fx.scatter)
+    });
+    bench(&mut c, &rec, "ik", "working_track", n, || {
+        let mut acc = 0.0;
+        fx.run_ik_tracker(&fx.path, |_, b| {
+            if let Some(w) = module_ik::working(b) {
+                acc += w.rho.x;
+            }
+        });
+        acc
     });
     bench(&mut c, &rec, "ik", "newton_warm", n, || fx.run_newton_ik());
 

@@ -139,8 +139,63 @@ pub fn leg_check(
     rho_i: f64,
     cos_tilt_max: f64,
 ) -> (i8, Verdict) {
-    let g = &m.module;
     let mut v = Verdict::default();
+    let (q, tilted) = leg_state(m, leg, p, s, c, rho_i, cos_tilt_max);
+    let sign = if q > CONFIG_SIGN_MM { 1 } else { -1 };
+    if sign != -1 {
+        v.add(
+            [
+                Reason::Leg1Inverted,
+                Reason::Leg2Inverted,
+                Reason::Leg3Inverted,
+            ][leg],
+        );
+    }
+    if outside_stroke(m, leg, rho_i) {
+        v.add([Reason::Rho1Stroke, Reason::Rho2Stroke, Reason::Rho3Stroke][leg]);
+    }
+    if tilted {
+        v.add(Reason::RodTilt);
+    }
+    (sign, v)
+}
+
+/// True when [`leg_check`] finds nothing against the leg: s_i = -1, inside its stroke, rods not
+/// too tilted (without building the verdict).
+#[inline]
+pub fn leg_ok(
+    m: &Machine,
+    leg: usize,
+    p: &nalgebra::Vector3<f64>,
+    s: f64,
+    c: f64,
+    rho_i: f64,
+    cos_tilt_max: f64,
+) -> bool {
+    let (q, tilted) = leg_state(m, leg, p, s, c, rho_i, cos_tilt_max);
+    let inverted = q > CONFIG_SIGN_MM;
+    !inverted && !tilted && !outside_stroke(m, leg, rho_i)
+}
+
+#[inline]
+fn outside_stroke(m: &Machine, leg: usize, rho_i: f64) -> bool {
+    rho_i < m.limits.rho_min[leg] - LIMIT_SLACK || rho_i > m.limits.rho_max[leg] + LIMIT_SLACK
+}
+
+/// The signed quantity whose sign is the leg's configuration index (rho1 - zp,
+/// rho2 - zp + R2 sin(alpha), rho3 - zp - R2 sin(alpha)), and whether one of its rods is tilted
+/// beyond the limit.
+#[inline]
+fn leg_state(
+    m: &Machine,
+    leg: usize,
+    p: &nalgebra::Vector3<f64>,
+    s: f64,
+    c: f64,
+    rho_i: f64,
+    cos_tilt_max: f64,
+) -> (f64, bool) {
+    let g = &m.module;
     // r.z < cos_tilt_max |r|, squared (no square root).
     let ct2 = cos_tilt_max * cos_tilt_max;
     let too_tilted = |r: nalgebra::Vector3<f64>| {
@@ -151,7 +206,7 @@ pub fn leg_check(
             r.z < 0.0 && zz > ct2 * r.norm_squared()
         }
     };
-    let (q, tilted) = match leg {
+    match leg {
         0 => {
             let (dy, dz) = (g.r_big1 * c - g.r_small1, g.r_big1 * s);
             let u = p.x + g.dx1;
@@ -175,24 +230,7 @@ pub fn leg_check(
             );
             (rho_i - p.z - g.r_big2 * s, too_tilted(r6))
         }
-    };
-    let sign = if q > CONFIG_SIGN_MM { 1 } else { -1 };
-    if sign != -1 {
-        v.add(
-            [
-                Reason::Leg1Inverted,
-                Reason::Leg2Inverted,
-                Reason::Leg3Inverted,
-            ][leg],
-        );
     }
-    if rho_i < m.limits.rho_min[leg] - LIMIT_SLACK || rho_i > m.limits.rho_max[leg] + LIMIT_SLACK {
-        v.add([Reason::Rho1Stroke, Reason::Rho2Stroke, Reason::Rho3Stroke][leg]);
-    }
-    if tilted {
-        v.add(Reason::RodTilt);
-    }
-    (sign, v)
 }
 
 /// cos of the largest rod tilt with its slack, for [`leg_check`].

@@ -7,7 +7,7 @@
 
 use arrayvec::ArrayVec;
 
-use crate::poly::{Root, eval_with_error, push_unique, roots_in};
+use crate::poly::{Root, push_unique, roots_in};
 
 /// The roots on one interval: at most three, plus critical points reported as touching.
 pub type CubicRoots = ArrayVec<Root, 8>;
@@ -63,6 +63,18 @@ pub fn cubic_roots_in(c: &[f64; 4], lo: f64, hi: f64) -> CubicRoots {
     out
 }
 
+/// p(x) and a bound on its rounding error, as [`crate::poly::eval_with_error`] for degree 3.
+#[inline]
+fn eval_with_error(c: &[f64; 4], x: f64) -> (f64, f64) {
+    let ax = x.abs();
+    let p3 = c[3];
+    let p2 = p3 * x + c[2];
+    let p1 = p2 * x + c[1];
+    let p0 = p1 * x + c[0];
+    let bound = ((p3.abs() * ax + p2.abs()) * ax + p1.abs()) * ax + p0.abs();
+    (p0, bound * 16.0 * f64::EPSILON)
+}
+
 /// The root of a cubic that is monotone on [a, b] with p(a), p(b) of opposite signs: Halley
 /// steps from the secant point, every step kept inside the shrinking bracket (bisection
 /// otherwise). Halley's error after a step d is about C d^3 (C from p's derivatives); the
@@ -97,9 +109,11 @@ fn bracketed(c: &[f64; 4], mut a: f64, mut b: f64, fa: f64, fb: f64) -> Root {
             x = 0.5 * (a + b);
         } else {
             x = next;
-            let (r2, r3) = (d2 / d1, 6.0 * c[3] / d1);
-            let error = (0.25 * r2 * r2 + r3.abs() / 6.0) * step.abs().powi(3);
-            if step.abs() <= tiny || error <= 0.5 * f64::EPSILON * x.abs() {
+            // error = (r2^2 / 4 + |r3| / 6) |step|^3 with r2 = p''/p', r3 = p'''/p', multiplied
+            // through by p'^2 (no division).
+            let s = step.abs();
+            let error_d1sq = (0.25 * d2 * d2 + (c[3] * d1).abs()) * (s * s * s);
+            if s <= tiny || error_d1sq <= 0.5 * f64::EPSILON * x.abs() * (d1 * d1) {
                 break;
             }
         }

@@ -7,7 +7,7 @@
 use arrayvec::ArrayVec;
 use nalgebra::Vector3;
 
-use crate::branches::{Config, Verdict, combine, cos_tilt_max, leg_check};
+use crate::branches::{Config, Verdict, WORKING_CONFIG, combine, cos_tilt_max, leg_check, leg_ok};
 use crate::cubic::cubic_roots_in;
 use crate::machine::{Machine, ModuleGeometry};
 use crate::module_geometry::Sliders;
@@ -38,16 +38,27 @@ pub type IkBranches = ArrayVec<IkBranch, MAX_IK_BRANCHES>;
 
 /// A leg-I posture: an orientation alpha and the slider-1 position that goes with it.
 #[derive(Debug, Clone, Copy)]
-struct Leg1 {
-    alpha: f64,
-    rho1: f64,
-    sin: f64,
-    cos: f64,
+pub(crate) struct Leg1 {
+    pub alpha: f64,
+    pub rho1: f64,
+    pub sin: f64,
+    pub cos: f64,
 }
 
 /// The cubic eq. (9) in cos(alpha) for the point, normalised, lowest degree first; None when it
 /// is degenerate (every coefficient zero or not finite).
 pub fn cubic_eq9(g: &ModuleGeometry, p: &Vector3<f64>) -> Option<[f64; 4]> {
+    let c = eq9_coefficients(g, p);
+    let scale = c.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+    if scale == 0.0 || !scale.is_finite() {
+        return None;
+    }
+    Some(c.map(|a| a / scale))
+}
+
+/// The coefficients of eq. (9), lowest degree first, as they come (not normalised).
+#[inline]
+pub(crate) fn eq9_coefficients(g: &ModuleGeometry, p: &Vector3<f64>) -> [f64; 4] {
     let (r, rr) = (g.r_big1, g.r_small1);
     let u = p.x + g.dx1;
     let y = p.y;
@@ -57,11 +68,7 @@ pub fn cubic_eq9(g: &ModuleGeometry, p: &Vector3<f64>) -> Option<[f64; 4]> {
     let p2 = r * r * k0 - r * r * u * u;
     let p3 = -2.0 * r * r * r * rr - 2.0 * r * rr * y * y;
     let p4 = r * r * u * u + (r * r + rr * rr) * y * y - r * r * k0;
-    let scale = p1.abs().max(p2.abs()).max(p3.abs()).max(p4.abs());
-    if scale == 0.0 || !scale.is_finite() {
-        return None;
-    }
-    Some([p4 / scale, p3 / scale, p2 / scale, p1 / scale])
+    [p4, p3, p2, p1]
 }
 
 /// |rho1 - zp| from eq. (11) at cos(alpha) = c, squared (negative when leg I cannot reach).
@@ -72,18 +79,24 @@ fn leg1_height_sq(g: &ModuleGeometry, p: &Vector3<f64>, c: f64) -> f64 {
     k1 - u * u - p.y * p.y
 }
 
-/// Every real leg-I posture (alpha, rho1) for the point: eqs. (9), (11), (14), polished by Newton
-/// on eqs. (10) and (14) (the half-sum and half-difference of (3) and (4)).
-fn leg1_postures(g: &ModuleGeometry, p: &Vector3<f64>) -> ArrayVec<Leg1, 6> {
+/// Every real leg-I posture (alpha, rho1) for the point into `out`: eqs. (9), (11), (14),
+/// polished by Newton on eqs. (10) and (14) (the half-sum and half-difference of (3) and (4)).
+fn leg1_postures_into(g: &ModuleGeometry, p: &Vector3<f64>, out: &mut ArrayVec<Leg1, 6>) {
     let (r, rr) = (g.r_big1, g.r_small1);
-    let y = p.y;
-    let mut out = ArrayVec::new();
+    out.clear();
     let Some(coeffs) = cubic_eq9(g, p) else {
-        return out;
+        return;
+    };
+    let mut push = |l: Leg1| {
+        let dup = out.iter().any(|o: &Leg1| {
+            (o.rho1 - l.rho1).abs() < 1e-7 && angle_diff(o.alpha, l.alpha).abs() < SAME_SOLUTION_RAD
+        });
+        if !dup && !out.is_full() {
+            out.push(l);
+        }
     };
     for root in cubic_roots_in(&coeffs, -1.0, 1.0) {
         let c = root.x.clamp(-1.0, 1.0);
-        let a = c.acos();
         let sin_a = ((1.0 - c) * (1.0 + c)).sqrt();
         let h2 = leg1_height_sq(g, p, c);
         let h = if h2 >= -SQRT_ARG_REL * g.l1 * g.l1 {
@@ -91,84 +104,171 @@ fn leg1_postures(g: &ModuleGeometry, p: &Vector3<f64>) -> ArrayVec<Leg1, 6> {
         } else {
             continue;
         };
-        let candidates: ArrayVec<Leg1, 4> = if sin_a < SIN_ALPHA_ZERO {
+        if sin_a < SIN_ALPHA_ZERO {
             // alpha in {0, pi}: eq. (14) is 0 = 0, both signs of eq. (11) (Table II).
             let a0 = if c > 0.0 { 0.0 } else { std::f64::consts::PI };
             let (sin, cos) = a0.sin_cos();
-            [p.z + h, p.z - h]
-                .into_iter()
-                .map(|rho1| Leg1 {
-                    alpha: a0,
-                    rho1,
-                    sin,
-                    cos,
-                })
-                .collect()
-        } else {
-            // sgn(rho1 - zp) from eq. (14): y (R1 cos a - r1) = R1 sin a (rho1 - zp).
-            let w = r * c - rr;
-            [(a, sin_a), (-a, -sin_a)]
-                .into_iter()
-                .map(|(alpha, sin)| {
-                    let q = y * w / (r * sin);
-                    let rho1 = if q == 0.0 { p.z } else { p.z + q.signum() * h };
+            for rho1 in [p.z + h, p.z - h] {
+                push(polish_leg1(
+                    g,
+                    p,
                     Leg1 {
-                        alpha,
+                        alpha: a0,
                         rho1,
                         sin,
-                        cos: c,
-                    }
-                })
-                .collect()
-        };
-        for cand in candidates {
-            let polished = polish_leg1(g, p, cand);
-            let dup = out.iter().any(|o: &Leg1| {
-                (o.rho1 - polished.rho1).abs() < 1e-7
-                    && angle_diff(o.alpha, polished.alpha).abs() < SAME_SOLUTION_RAD
-            });
-            if !dup && !out.is_full() {
-                out.push(polished);
+                        cos,
+                    },
+                ));
             }
+            continue;
         }
+        // sgn(rho1 - zp) from eq. (14): y (R1 cos a - r1) = R1 sin a (rho1 - zp).
+        let q = p.y * (r * c - rr) / (r * sin_a);
+        let rho1 = if q == 0.0 { p.z } else { p.z + q.signum() * h };
+        let polished = polish_leg1(
+            g,
+            p,
+            Leg1 {
+                alpha: c.acos(),
+                rho1,
+                sin: sin_a,
+                cos: c,
+            },
+        );
+        // Eqs. (10) and (14) are unchanged by (alpha, z - rho1) -> (-alpha, rho1 - z): the
+        // posture at -alpha is the mirror image of this one, as exact, and needs no polish.
+        let mirror = with_wrapped_alpha(Leg1 {
+            alpha: -polished.alpha,
+            rho1: p.z + (p.z - polished.rho1),
+            sin: -polished.sin,
+            cos: polished.cos,
+        });
+        push(polished);
+        push(mirror);
     }
-    out
 }
+
+/// A leg-I polish also stops when Newton's next step is predicted below this fraction of
+/// [`NEWTON_STEP_STOP`] (relative for rho1): the rounding of the result, so the step left out
+/// changes nothing.
+const PREDICTED_STEP_FRACTION: f64 = 1e-3;
 
 /// Newton on g1 = u^2 + y^2 + (z - rho1)^2 - K1(alpha) (eq. (10)) and
 /// g2 = y (R1 cos a - r1) + R1 sin a (z - rho1) (eq. (14)), unknowns (alpha, rho1), from a
 /// posture whose sin and cos are given; the result carries the sin and cos of its alpha.
 fn polish_leg1(g: &ModuleGeometry, p: &Vector3<f64>, start: Leg1) -> Leg1 {
-    let (r, rr) = (g.r_big1, g.r_small1);
-    let u = p.x + g.dx1;
-    let y = p.y;
-    let k0 = g.l1 * g.l1 - r * r - rr * rr;
-    let residuals = |l: &Leg1| {
-        let dz = p.z - l.rho1;
-        let f = [
-            u * u + y * y + dz * dz - k0 - 2.0 * r * rr * l.cos,
-            y * (r * l.cos - rr) + r * l.sin * dz,
-        ];
-        (f, dz)
-    };
+    polish_leg1_converged(g, p, start).0
+}
+
+/// [`polish_leg1`], and whether it converged (residuals at rounding level, or Newton's last or
+/// next step below [`NEWTON_STEP_STOP`]) rather than ran out of iterations or met a singular
+/// Jacobian.
+pub(crate) fn polish_leg1_converged(
+    g: &ModuleGeometry,
+    p: &Vector3<f64>,
+    start: Leg1,
+) -> (Leg1, bool) {
+    let eqs = Leg1Equations::new(g, p);
     let amax = |f: [f64; 2]| f[0].abs().max(f[1].abs());
     let mut cur = start;
-    let (mut f, mut dz) = residuals(&cur);
-    // Residuals already at the rounding level of their terms: no step can improve the start.
-    let rounding = [
-        u * u + y * y + dz * dz + k0.abs() + (2.0 * r * rr * cur.cos).abs(),
-        (y * r * cur.cos).abs() + (y * rr).abs() + (r * cur.sin * dz).abs(),
-    ];
-    if f[0].abs() <= 4.0 * f64::EPSILON * rounding[0]
-        && f[1].abs() <= 4.0 * f64::EPSILON * rounding[1]
-    {
-        return with_wrapped_alpha(cur);
+    let (mut f, mut dz) = eqs.residuals(&cur);
+    if eqs.at_rounding(&cur, f, dz) {
+        return (with_wrapped_alpha(cur), true);
     }
     let mut best = (cur, amax(f));
     for _ in 0..NEWTON_MAX_ITER {
         if amax(f) == 0.0 {
             break;
         }
+        let Some((next, settled)) = eqs.newton_step(&cur, f, dz) else {
+            break;
+        };
+        cur = next;
+        if settled {
+            return (with_wrapped_alpha(cur), true);
+        }
+        (f, dz) = eqs.residuals(&cur);
+        if amax(f) <= best.1 {
+            best = (cur, amax(f));
+        }
+    }
+    (with_wrapped_alpha(best.0), false)
+}
+
+/// One Newton step on eqs. (10) and (14) from `start` when it settles the posture (the step,
+/// or the step after it, below [`NEWTON_STEP_STOP`]: Newton has converged to rounding); else
+/// the complete [`polish_leg1_converged`] from there. None when that does not converge either.
+#[inline]
+pub(crate) fn newton_leg1(g: &ModuleGeometry, p: &Vector3<f64>, start: Leg1) -> Option<Leg1> {
+    let eqs = Leg1Equations::new(g, p);
+    let (f, dz) = eqs.residuals(&start);
+    let (next, settled) = eqs.newton_step(&start, f, dz)?;
+    if settled {
+        return Some(with_wrapped_alpha(next));
+    }
+    let (polished, converged) = polish_leg1_converged(g, p, next);
+    converged.then_some(polished)
+}
+
+/// Eqs. (10) and (14) of leg I for one point, as g1 = u^2 + y^2 + (z - rho1)^2 - K1(alpha) and
+/// g2 = y (R1 cos a - r1) + R1 sin a (z - rho1), unknowns (alpha, rho1).
+struct Leg1Equations {
+    r: f64,
+    rr: f64,
+    y: f64,
+    z: f64,
+    /// u^2 + y^2 - (L1^2 - R1^2 - r1^2).
+    uy_k0: f64,
+    /// u^2 + y^2 + |L1^2 - R1^2 - r1^2|, for the rounding of g1.
+    uy_k0_abs: f64,
+}
+
+impl Leg1Equations {
+    #[inline]
+    fn new(g: &ModuleGeometry, p: &Vector3<f64>) -> Leg1Equations {
+        let (r, rr) = (g.r_big1, g.r_small1);
+        let u = p.x + g.dx1;
+        let k0 = g.l1 * g.l1 - r * r - rr * rr;
+        let uy = u * u + p.y * p.y;
+        Leg1Equations {
+            r,
+            rr,
+            y: p.y,
+            z: p.z,
+            uy_k0: uy - k0,
+            uy_k0_abs: uy + k0.abs(),
+        }
+    }
+
+    /// (g1, g2) and z - rho1.
+    #[inline]
+    fn residuals(&self, l: &Leg1) -> ([f64; 2], f64) {
+        let (r, rr, y) = (self.r, self.rr, self.y);
+        let dz = self.z - l.rho1;
+        let f = [
+            self.uy_k0 + dz * dz - 2.0 * r * rr * l.cos,
+            y * (r * l.cos - rr) + r * l.sin * dz,
+        ];
+        (f, dz)
+    }
+
+    /// Residuals already at the rounding level of their terms: no step can improve the posture.
+    #[inline]
+    fn at_rounding(&self, l: &Leg1, f: [f64; 2], dz: f64) -> bool {
+        let (r, rr, y) = (self.r, self.rr, self.y);
+        let rounding = [
+            self.uy_k0_abs + dz * dz + (2.0 * r * rr * l.cos).abs(),
+            (y * r * l.cos).abs() + (y * rr).abs() + (r * l.sin * dz).abs(),
+        ];
+        f[0].abs() <= 4.0 * f64::EPSILON * rounding[0]
+            && f[1].abs() <= 4.0 * f64::EPSILON * rounding[1]
+    }
+
+    /// The Newton step from `cur` (residuals f, dz = z - rho1), and whether it settles the
+    /// posture; None on a singular Jacobian.
+    #[inline]
+    fn newton_step(&self, cur: &Leg1, f: [f64; 2], dz: f64) -> Option<(Leg1, bool)> {
+        let (r, rr, y) = (self.r, self.rr, self.y);
         // Jacobian of (g1, g2) in (alpha, rho1), solved by Cramer's rule.
         let (s, c) = (cur.sin, cur.cos);
         let (j11, j12, j21, j22) = (2.0 * r * rr * s, -2.0 * dz, -y * r * s + r * c * dz, -r * s);
@@ -177,28 +277,35 @@ fn polish_leg1(g: &ModuleGeometry, p: &Vector3<f64>, start: Leg1) -> Leg1 {
             (j22 * f[0] - j12 * f[1]) / det,
             (j11 * f[1] - j21 * f[0]) / det,
         ];
-        if det == 0.0 || !step.iter().all(|v| v.is_finite()) {
-            break;
+        if det == 0.0 || !(step[0].is_finite() && step[1].is_finite()) {
+            return None;
         }
         let alpha = cur.alpha - step[0];
         let (sin, cos) = sin_cos_after_step(cur.sin, cur.cos, alpha, step[0]);
-        cur = Leg1 {
+        let next = Leg1 {
             alpha,
             rho1: cur.rho1 - step[1],
             sin,
             cos,
         };
-        (f, dz) = residuals(&cur);
-        if amax(f) <= best.1 {
-            best = (cur, amax(f));
+        let rho_stop = NEWTON_STEP_STOP * (1.0 + next.rho1.abs());
+        // A step this small came from residuals at rounding level (Newton converges
+        // quadratically).
+        if step[0].abs() < NEWTON_STEP_STOP && step[1].abs() < rho_stop {
+            return Some((next, true));
         }
-        if step[0].abs() < NEWTON_STEP_STOP
-            && step[1].abs() < NEWTON_STEP_STOP * (1.0 + cur.rho1.abs())
-        {
-            break;
-        }
+        // Otherwise Newton's error after this step is J^-1 times what the linear model missed,
+        // (1/2) H[step, step] (H: second derivatives of g1, g2, which are quadratic in rho1 and
+        // trigonometric in alpha). Once that is far below the step stop, so is the next step.
+        let (da, dr) = (step[0].abs(), step[1].abs());
+        let miss1 = (r * rr * c).abs() * da * da + dr * dr;
+        let miss2 = 0.5 * (y * r * c + r * s * dz).abs() * da * da + (r * c).abs() * da * dr;
+        let next_alpha = j22.abs() * miss1 + j12.abs() * miss2;
+        let next_rho1 = j21.abs() * miss1 + j11.abs() * miss2;
+        let settled = next_alpha <= PREDICTED_STEP_FRACTION * NEWTON_STEP_STOP * det.abs()
+            && next_rho1 <= PREDICTED_STEP_FRACTION * rho_stop * det.abs();
+        Some((next, settled))
     }
-    with_wrapped_alpha(best.0)
 }
 
 /// The posture with alpha in (-pi, pi] (sin and cos recomputed if it moved).
@@ -257,15 +364,37 @@ pub fn solve_into(m: &Machine, p: &Vector3<f64>, out: &mut IkBranches) {
     let cos_tilt = cos_tilt_max(m);
     // Branches come out ordered by alpha, then (s1, s2, s3): postures sorted by (alpha, s1), and
     // within a posture s2, s3 = -1 before +1 (the roots of (12)-(13) in increasing order).
-    let mut postures: ArrayVec<(Leg1, f64, f64, (i8, Verdict)), 6> = leg1_postures(g, p)
-        .into_iter()
-        .map(|l| {
-            let (s, c) = (l.sin, l.cos);
-            (l, s, c, leg_check(m, 0, p, s, c, l.rho1, cos_tilt))
-        })
-        .collect();
-    postures.sort_unstable_by(|a, b| a.0.alpha.total_cmp(&b.0.alpha).then(a.3.0.cmp(&b.3.0)));
-    for (leg1, s, c, l1) in postures {
+    let mut legs1 = ArrayVec::<Leg1, 6>::new();
+    leg1_postures_into(g, p, &mut legs1);
+    let n = legs1.len();
+    let mut checks = [(0i8, Verdict::default()); 6];
+    for (k, l) in legs1.iter().enumerate() {
+        checks[k] = leg_check(m, 0, p, l.sin, l.cos, l.rho1, cos_tilt);
+    }
+    // Postures come in pairs (alpha >= 0, its mirror) by increasing cos(alpha): the mirrors in
+    // that order, then the others in reverse, is usually the order already; sorted if not.
+    let mut order = [0usize; 6];
+    let (mut front, mut back) = (0, n);
+    for k in 0..n {
+        if legs1[k].alpha < 0.0 {
+            order[front] = k;
+            front += 1;
+        } else {
+            back -= 1;
+            order[back] = k;
+        }
+    }
+    let key = |k: usize| (legs1[k].alpha, checks[k].0);
+    let before = |a: usize, b: usize| {
+        let (ka, kb) = (key(a), key(b));
+        ka.0.total_cmp(&kb.0).then(ka.1.cmp(&kb.1))
+    };
+    if order[..n].windows(2).any(|w| before(w[0], w[1]).is_gt()) {
+        order[..n].sort_unstable_by(|&a, &b| before(a, b));
+    }
+    for &k in &order[..n] {
+        let (leg1, l1) = (legs1[k], checks[k]);
+        let (s, c) = (leg1.sin, leg1.cos);
         let dx2 = p.x + g.dx2;
         // eq. (12): rho2 = zp - R2 sin a + s2 sqrt(L2^2 - (xp + D2 - d2)^2 - (yp - R2 cos a + r4)^2)
         let Some(r2) = leg_sliders(g.l2, dx2, p.y - g.r_big2 * c + g.r4, p.z - g.r_big2 * s) else {
@@ -294,8 +423,8 @@ pub fn solve_into(m: &Machine, p: &Vector3<f64>, out: &mut IkBranches) {
 
 /// How far (mm) a configuration sign or a square root must be from zero, and (rad) two candidate
 /// angles from each other, for [`working_fast`] to decide alone; closer calls go to [`solve`].
-const FAST_MARGIN_MM: f64 = 1e-6;
-const FAST_MARGIN_RAD: f64 = 1e-6;
+pub(crate) const FAST_MARGIN_MM: f64 = 1e-6;
+pub(crate) const FAST_MARGIN_RAD: f64 = 1e-6;
 
 /// The working branch alone, without building the others, when the decision is clear-cut; None
 /// when unsure or when there is no feasible branch (the caller then runs [`solve`], which also
@@ -348,37 +477,11 @@ pub fn working_fast(m: &Machine, p: &Vector3<f64>) -> Option<IkBranch> {
                 cos: c,
             },
         );
-        let (s, c) = (leg1.sin, leg1.cos);
-        let dx2 = p.x + g.dx2;
-        let lower = |l: f64, dy: f64, offset: f64| match leg_sliders(l, dx2, dy, offset) {
-            Some([lo, hi]) if hi - lo > 2.0 * FAST_MARGIN_MM => Ok(Some(lo)),
-            Some(_) => Err(()),
-            None if l * l - dx2 * dx2 - dy * dy > -FAST_MARGIN_MM * l => Err(()),
-            None => Ok(None),
-        };
-        let (Ok(r2), Ok(r3)) = (
-            lower(g.l2, p.y - g.r_big2 * c + g.r4, p.z - g.r_big2 * s),
-            lower(g.l3, p.y + g.r_big2 * c - g.r4, p.z + g.r_big2 * s),
-        ) else {
+        let Ok(found) = working_on_posture(m, p, &leg1, cos_tilt) else {
             return None;
         };
-        let (Some(rho2), Some(rho3)) = (r2, r3) else {
+        let Some(branch) = found else {
             continue;
-        };
-        let legs = [
-            leg_check(m, 0, p, s, c, leg1.rho1, cos_tilt),
-            leg_check(m, 1, p, s, c, rho2, cos_tilt),
-            leg_check(m, 2, p, s, c, rho3, cos_tilt),
-        ];
-        let verdict = combine(m, c, [legs[0].1, legs[1].1, legs[2].1]);
-        if !verdict.feasible() {
-            continue;
-        }
-        let branch = IkBranch {
-            alpha: leg1.alpha,
-            rho: Sliders::new(leg1.rho1, rho2, rho3),
-            config: [legs[0].0, legs[1].0, legs[2].0],
-            verdict,
         };
         match best {
             Some(b) if (b.alpha.abs() - branch.alpha.abs()).abs() < FAST_MARGIN_RAD => return None,
@@ -387,6 +490,44 @@ pub fn working_fast(m: &Machine, p: &Vector3<f64>) -> Option<IkBranch> {
         }
     }
     best
+}
+
+/// The branch on a leg-I posture (s1 = -1) with the lower roots of eqs. (12)-(13) (s2 = s3 = -1)
+/// when it is feasible: Ok(Some); Ok(None) when it is not feasible or a leg cannot reach; Err
+/// when a square root of (12)-(13) is within [`FAST_MARGIN_MM`] of zero (the labels of the two
+/// roots are then a close call for [`solve`]).
+pub(crate) fn working_on_posture(
+    m: &Machine,
+    p: &Vector3<f64>,
+    leg1: &Leg1,
+    cos_tilt: f64,
+) -> Result<Option<IkBranch>, ()> {
+    let g = &m.module;
+    let (s, c) = (leg1.sin, leg1.cos);
+    let dx2 = p.x + g.dx2;
+    let lower = |l: f64, dy: f64, offset: f64| match leg_sliders(l, dx2, dy, offset) {
+        Some([lo, hi]) if hi - lo > 2.0 * FAST_MARGIN_MM => Ok(Some(lo)),
+        Some(_) => Err(()),
+        None if l * l - dx2 * dx2 - dy * dy > -FAST_MARGIN_MM * l => Err(()),
+        None => Ok(None),
+    };
+    let r2 = lower(g.l2, p.y - g.r_big2 * c + g.r4, p.z - g.r_big2 * s)?;
+    let r3 = lower(g.l3, p.y + g.r_big2 * c - g.r4, p.z + g.r_big2 * s)?;
+    let (Some(rho2), Some(rho3)) = (r2, r3) else {
+        return Ok(None);
+    };
+    // Feasible: every leg as on the machine and inside its limits, rods of leg I not crossing
+    // (what [`combine`] of the three [`leg_check`]s says, without building the verdict).
+    let feasible = leg_ok(m, 0, p, s, c, leg1.rho1, cos_tilt)
+        && leg_ok(m, 1, p, s, c, rho2, cos_tilt)
+        && leg_ok(m, 2, p, s, c, rho3, cos_tilt)
+        && g.r_big1 * c > g.r_small1;
+    Ok(feasible.then_some(IkBranch {
+        alpha: leg1.alpha,
+        rho: Sliders::new(leg1.rho1, rho2, rho3),
+        config: WORKING_CONFIG,
+        verdict: Verdict::default(),
+    }))
 }
 
 /// What `verne ik` needs for one point: the working branch alone when [`working_fast`] is sure

@@ -7,6 +7,7 @@ use nalgebra::Vector3;
 use crate::branches::{Config, Verdict};
 use crate::error::VerneError;
 use crate::fk_track::FkTracker;
+use crate::ik_track::IkTracker;
 use crate::machine::Machine;
 use crate::module_fk::{self, FkModes};
 use crate::module_ik::{self, IkBranches};
@@ -41,6 +42,28 @@ impl RowJob for ModuleIk {
             module_ik::solve_into(&self.machine, &p, solved);
         } else {
             module_ik::solve_working_into(&self.machine, &p, solved);
+        }
+    }
+
+    /// The working branch is followed from row to row within a run ([`IkTracker`]); `--all`
+    /// solves every row completely.
+    fn solve_run<'a>(&self, rows: &mut dyn Iterator<Item = (Option<&'a [f64]>, &'a mut IkBranches)>)
+    where
+        IkBranches: 'a,
+    {
+        if self.all {
+            for (inputs, solved) in rows {
+                if let Some(v) = inputs {
+                    self.solve(v, solved);
+                }
+            }
+            return;
+        }
+        let mut tracker = IkTracker::new(&self.machine);
+        for (inputs, solved) in rows {
+            if let Some(v) = inputs {
+                tracker.working_into(&Vector3::new(v[0], v[1], v[2]), solved);
+            }
         }
     }
 

@@ -15,8 +15,8 @@ pub fn sin_cos_after_step(sin_a: f64, cos_a: f64, alpha: f64, d: f64) -> (f64, f
         return alpha.sin_cos();
     }
     let d2 = d * d;
-    let sd = d * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0));
-    let cd = 1.0 - d2 / 2.0 * (1.0 - d2 / 12.0);
+    let sd = d * (1.0 - d2 * (1.0 / 6.0) * (1.0 - d2 * (1.0 / 20.0)));
+    let cd = 1.0 - d2 * 0.5 * (1.0 - d2 * (1.0 / 12.0));
     (sin_a * cd - cos_a * sd, cos_a * cd + sin_a * sd)
 }
 

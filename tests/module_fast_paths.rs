@@ -272,3 +272,133 @@ fn tracked_fk_matches_the_complete_solver_through_branch_switches() {
         "{tracked} of {rows_present}"
     );
 }
+
+// ------------------------------------------------------------ IK: the working branch tracked
+
+use verne::ik_track::IkTracker;
+
+/// Compares the tracked working branch with the complete solver's on every point of a path;
+/// returns (points with a working branch, points answered by tracking).
+fn ik_tracked_agrees(m: &Machine, path: &[Vector3<f64>]) -> (usize, u64) {
+    let mut tracker = IkTracker::new(m);
+    let mut got = IkBranches::new();
+    let mut present = 0;
+    for p in path {
+        tracker.working_into(p, &mut got);
+        let t = module_ik::working(&got).copied();
+        let full = module_ik::solve(m, p);
+        let e = module_ik::working(&full);
+        assert_eq!(t.is_some(), e.is_some(), "p={p:?}: tracked {t:?} vs {e:?}");
+        if let (Some(t), Some(e)) = (t, e) {
+            present += 1;
+            let (da, dr) = ((t.alpha - e.alpha).abs(), (t.rho - e.rho).amax());
+            assert!(
+                da < 1e-12 && dr < 1e-9 && t.config == e.config && t.verdict == e.verdict,
+                "p={p:?}: tracked {t:?} vs {e:?} (d alpha {da:e}, d rho {dr:e})"
+            );
+        }
+    }
+    assert_eq!(tracker.tracked + tracker.solved, path.len() as u64);
+    (present, tracker.tracked)
+}
+
+fn helix_points(rows: usize) -> Vec<Vector3<f64>> {
+    (0..rows)
+        .map(|k| {
+            let t = k as f64 / rows as f64;
+            let a = t * std::f64::consts::TAU;
+            Vector3::new(
+                -250.0 + 120.0 * a.cos(),
+                120.0 * a.sin(),
+                1000.0 + 300.0 * t,
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn tracked_ik_matches_the_complete_solver_along_a_helix() {
+    let m = Machine::default_verne();
+    let path = helix_points(4096);
+    let (present, tracked) = ik_tracked_agrees(&m, &path);
+    assert_eq!(present, path.len());
+    // The helix crosses y_p = 0 twice (alpha = 0: handed over within the margin); every other
+    // row is tracked.
+    assert!(
+        tracked as usize >= path.len() - 8,
+        "{tracked} of {}",
+        path.len()
+    );
+}
+
+/// Without continuity the tracker still answers right (Newton from an unrelated posture either
+/// reaches the certified posture or hands over).
+#[test]
+fn tracked_ik_matches_the_complete_solver_on_scattered_points() {
+    let m = Machine::default_verne();
+    let mut r = Lcg(5);
+    let pts: Vec<Vector3<f64>> = (0..20_000)
+        .map(|_| {
+            Vector3::new(
+                -700.0 + 1200.0 * r.unit(),
+                -600.0 + 1200.0 * r.unit(),
+                400.0 + 1300.0 * r.unit(),
+            )
+        })
+        .collect();
+    let (present, tracked) = ik_tracked_agrees(&m, &pts);
+    eprintln!("{present} with a working branch, {tracked} tracked");
+    assert!(present > 1000);
+}
+
+/// Along rays through the places where the working branch ends (a joint or rod limit, two
+/// roots of (9) meeting, rods of leg I crossing) and across y_p = 0 (alpha through 0, where the
+/// two postures of a root meet), forwards and back at 0.05 mm per row.
+#[test]
+fn tracked_ik_matches_the_complete_solver_through_hand_over_places() {
+    let m = Machine::default_verne();
+    let starts = helix_points(64);
+    let mut r = Lcg(13);
+    let (mut crossings, mut rows_present, mut tracked) = (0, 0, 0);
+    let has = |p: Vector3<f64>| module_ik::working(&module_ik::solve(&m, &p)).is_some();
+    let mut rays = Vec::new();
+    for start in &starts {
+        for _ in 0..6 {
+            let dir = Vector3::new(r.unit() - 0.5, r.unit() - 0.5, r.unit() - 0.5).normalize();
+            let (mut a, mut b) = (0.0, 2000.0);
+            if !has(*start) || has(start + dir * b) {
+                continue;
+            }
+            for _ in 0..50 {
+                let mid = 0.5 * (a + b);
+                if has(start + dir * mid) {
+                    a = mid
+                } else {
+                    b = mid
+                }
+            }
+            crossings += 1;
+            rays.push((start + dir * (a - 10.0), dir));
+        }
+        // Across y_p = 0 along y.
+        rays.push((Vector3::new(start.x, -10.0, start.z), Vector3::y()));
+    }
+    for (from, dir) in rays {
+        let forward: Vec<Vector3<f64>> =
+            (0..=400).map(|k| from + dir * (0.05 * k as f64)).collect();
+        let back: Vec<Vector3<f64>> = forward.iter().rev().copied().collect();
+        for path in [forward, back] {
+            let (present, t) = ik_tracked_agrees(&m, &path);
+            rows_present += present;
+            tracked += t as usize;
+        }
+    }
+    eprintln!(
+        "{crossings} crossings; {tracked} of {rows_present} rows with a working branch tracked"
+    );
+    assert!(crossings > 200, "{crossings} crossings");
+    assert!(
+        tracked * 10 > rows_present * 9,
+        "{tracked} of {rows_present}"
+    );
+}
