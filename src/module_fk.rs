@@ -91,7 +91,9 @@ impl Elimination {
             -2.0 * r2 * p2,
         );
         let q = Trig::linear(-rr * p2, r * p2, r * r4 - rr * r2);
-        let u_num = a.mul(&det).add(&b.mul(&q).scale(2.0));
+        let u_num = a
+            .mul_deg::<1, 1>(&det)
+            .add(&b.mul_deg::<1, 1>(&q).scale(2.0));
         Elimination {
             w,
             b,
@@ -106,11 +108,13 @@ impl Elimination {
         let (r, rr) = (g.r_big1, g.r_small1);
         let n1 = Trig::linear(r * r + rr * rr, -2.0 * r * rr, 0.0);
         let k1 = Trig::linear(g.l1 * g.l1 - r * r - rr * rr, 2.0 * r * rr, 0.0);
-        let b2 = self.b.mul(&self.b);
-        let det2 = self.det.mul(&self.det);
-        let inner = b2.mul(&n1).add(&k1.mul(&det2).scale(-1.0));
+        let b2 = self.b.mul_deg::<1, 1>(&self.b);
+        let det2 = self.det.mul_deg::<1, 1>(&self.det);
+        let inner = b2
+            .mul_deg::<2, 1>(&n1)
+            .add(&k1.mul_deg::<1, 2>(&det2).scale(-1.0));
         self.u_num
-            .mul(&self.u_num)
+            .mul_deg::<2, 2>(&self.u_num)
             .add(&inner.scale(4.0 * self.delta * self.delta))
     }
 
@@ -244,8 +248,8 @@ pub fn solve(m: &Machine, rho: &Sliders) -> FkModes {
     let f = elim.characteristic(g);
     // Starting poses, each with (sin alpha, cos alpha).
     let mut starts: ArrayVec<(ModulePose, (f64, f64)), 68> = ArrayVec::new();
-    for &alpha in &f.roots() {
-        let sc = alpha.sin_cos();
+    for root in &f.roots_sin_cos() {
+        let (alpha, sc) = (root.x, (root.sin, root.cos));
         match elim.back_substitute(g, rho, alpha, sc) {
             Some(p) => starts.push((p, sc)),
             None => starts.extend(
@@ -275,7 +279,7 @@ pub fn solve(m: &Machine, rho: &Sliders) -> FkModes {
         starts.extend(on_spheres);
     }
     for &(start, sc) in &starts {
-        let (pose, residual) = polish_pose_from(g, start, sc, rho);
+        let (pose, residual, (s, c)) = polish_pose_from(g, start, sc, rho);
         if residual > ACCEPT_RESIDUAL_MM {
             continue;
         }
@@ -290,7 +294,7 @@ pub fn solve(m: &Machine, rho: &Sliders) -> FkModes {
         if dup || out.is_full() {
             continue;
         }
-        let (s, c) = pose.alpha.sin_cos();
+        // wrap_angle moves alpha by whole turns at most: the same sine and cosine.
         let (config, verdict) = label(m, &pose.p, s, c, rho);
         out.push(FkMode {
             pose,

@@ -4,6 +4,7 @@
 use nalgebra::{Matrix4, Matrix4x3, Vector3, Vector4};
 
 use crate::machine::ModuleGeometry;
+use crate::trig::sin_cos_after_step;
 
 /// Pose of the platform: point P (mm, base frame, z down) and its rotation alpha about x (rad).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -141,23 +142,26 @@ pub fn polish_pose_with_residual(
     start: ModulePose,
     rho: &Sliders,
 ) -> (ModulePose, f64) {
-    polish_pose_from(g, start, start.alpha.sin_cos(), rho)
+    let (pose, residual, _) = polish_pose_from(g, start, start.alpha.sin_cos(), rho);
+    (pose, residual)
 }
 
-/// [`polish_pose_with_residual`] from a start whose (sin alpha, cos alpha) are known.
+/// [`polish_pose_with_residual`] from a start whose (sin alpha, cos alpha) are known; also
+/// returns those of the result.
 pub fn polish_pose_from(
     g: &ModuleGeometry,
     start: ModulePose,
     (s, c): (f64, f64),
     rho: &Sliders,
-) -> (ModulePose, f64) {
+) -> (ModulePose, f64, (f64, f64)) {
     use crate::tolerance::{NEWTON_MAX_ITER, NEWTON_STEP_STOP};
     let l = rod_lengths(g);
     let as_mm = |f: &Vector4<f64>| (0..4).fold(0.0f64, |m, i| m.max((f[i] / (2.0 * l[i])).abs()));
     let mut cur = start;
+    let mut sc = (s, c);
     let (mut f, mut a) = residuals_jacobian_at(g, &cur, rho, s, c);
     let mut res = as_mm(&f);
-    let mut best = (cur, res);
+    let mut best = (cur, res, sc);
     for _ in 0..NEWTON_MAX_ITER {
         if res == 0.0 {
             break;
@@ -176,13 +180,13 @@ pub fn polish_pose_from(
             .max((step[3] * g.r_big1.max(g.r_big2)).abs());
         if size < FINAL_STEP_MM {
             // What such a step leaves is of the order of its square: no need to evaluate.
-            return (cur, res);
+            return (cur, res, sin_cos_after_step(sc.0, sc.1, cur.alpha, step[3]));
         }
-        let (s, c) = cur.alpha.sin_cos();
-        (f, a) = residuals_jacobian_at(g, &cur, rho, s, c);
+        sc = cur.alpha.sin_cos();
+        (f, a) = residuals_jacobian_at(g, &cur, rho, sc.0, sc.1);
         res = as_mm(&f);
         if res <= best.1 {
-            best = (cur, res);
+            best = (cur, res, sc);
         }
         if step.amax() < NEWTON_STEP_STOP * (1.0 + cur.p.amax()) {
             break;

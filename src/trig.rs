@@ -7,16 +7,39 @@ use arrayvec::ArrayVec;
 use crate::poly::Coeffs;
 
 /// sin and cos of `alpha` = a - d from those of a (a Newton step d): by the angle-difference
-/// formulas with the series of sin d and cos d (exact in double precision for |d| < 1e-3),
-/// else by `sin_cos`.
+/// formulas with the series of sin d and cos d (two terms for |d| < 1e-3, six up to 0.25: both
+/// exact in double precision), else by `sin_cos`.
 #[inline]
 pub fn sin_cos_after_step(sin_a: f64, cos_a: f64, alpha: f64, d: f64) -> (f64, f64) {
-    if d.abs() >= 1e-3 {
-        return alpha.sin_cos();
-    }
     let d2 = d * d;
-    let sd = d * (1.0 - d2 * (1.0 / 6.0) * (1.0 - d2 * (1.0 / 20.0)));
-    let cd = 1.0 - d2 * 0.5 * (1.0 - d2 * (1.0 / 12.0));
+    let (sd, cd) = if d.abs() < 1e-3 {
+        (
+            d * (1.0 - d2 * (1.0 / 6.0) * (1.0 - d2 * (1.0 / 20.0))),
+            1.0 - d2 * 0.5 * (1.0 - d2 * (1.0 / 12.0)),
+        )
+    } else if d.abs() < 0.25 {
+        // Next terms below d^13 / 13! and d^14 / 14!: under 1e-17 relative for |d| < 0.25.
+        let sd = d
+            * (1.0
+                - d2 * (1.0 / 6.0)
+                    * (1.0
+                        - d2 * (1.0 / 20.0)
+                            * (1.0
+                                - d2 * (1.0 / 42.0)
+                                    * (1.0 - d2 * (1.0 / 72.0) * (1.0 - d2 * (1.0 / 110.0))))));
+        let cd = 1.0
+            - d2 * 0.5
+                * (1.0
+                    - d2 * (1.0 / 12.0)
+                        * (1.0
+                            - d2 * (1.0 / 30.0)
+                                * (1.0
+                                    - d2 * (1.0 / 56.0)
+                                        * (1.0 - d2 * (1.0 / 90.0) * (1.0 - d2 * (1.0 / 132.0))))));
+        (sd, cd)
+    } else {
+        return alpha.sin_cos();
+    };
     (sin_a * cd - cos_a * sd, cos_a * cd + sin_a * sd)
 }
 
@@ -85,7 +108,20 @@ impl Trig {
 
     /// The product; the caller guarantees the degrees add up to at most [`MAX_HARMONIC`].
     pub fn mul(&self, o: &Trig) -> Trig {
-        let (da, db) = (self.degree(), o.degree());
+        self.mul_up_to(o, self.degree(), o.degree())
+    }
+
+    /// [`Trig::mul`] of a form of degree at most `DA` by one of degree at most `DB`, with the
+    /// loops fixed at compile time (the same sums in the same order: the same result).
+    #[inline]
+    pub fn mul_deg<const DA: usize, const DB: usize>(&self, o: &Trig) -> Trig {
+        const { assert!(DA + DB <= MAX_HARMONIC) };
+        debug_assert!(self.degree() <= DA && o.degree() <= DB);
+        self.mul_up_to(o, DA, DB)
+    }
+
+    #[inline(always)]
+    fn mul_up_to(&self, o: &Trig, da: usize, db: usize) -> Trig {
         debug_assert!(da + db <= MAX_HARMONIC);
         let mut r = Trig::default();
         for j in 0..=da {
@@ -171,6 +207,11 @@ impl Trig {
     /// half-angle polynomials of IFToMM 2007 section VI for the forward kinematics (one pass over
     /// the circle, no chart at alpha = pi, no recursion on derivatives).
     pub fn roots(&self) -> ArrayVec<f64, MAX_TRIG_ROOTS> {
+        self.roots_sin_cos().iter().map(|r| r.x).collect()
+    }
+
+    /// [`Trig::roots`], each with its sine and cosine (carried along the root finding).
+    pub fn roots_sin_cos(&self) -> ArrayVec<TrigRoot, MAX_TRIG_ROOTS> {
         let scale = self
             .cos
             .iter()
@@ -200,6 +241,8 @@ impl Trig {
         let step = std::f64::consts::PI / 16.0;
         let pt = |j: usize| Pt {
             x: (j as f64 - 16.0) * step,
+            sin: GRID_SIN[0][j % GRID],
+            cos: GRID_COS[0][j % GRID],
             f: fv[j % GRID],
             d: dv[j % GRID],
             s: sv[j % GRID],
@@ -233,6 +276,14 @@ impl Trig {
         }
         out
     }
+}
+
+/// A root x of a trigonometric polynomial with sin x and cos x.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrigRoot {
+    pub x: f64,
+    pub sin: f64,
+    pub cos: f64,
 }
 
 /// Most roots [`Trig::roots`] returns: 2 [`MAX_HARMONIC`] simple roots, plus candidates at
@@ -290,10 +341,12 @@ const GRID_SIN: [[f64; GRID]; MAX_HARMONIC] = grid_table(true);
 /// more, within rounding) is given up and its midpoint reported as a candidate.
 const MAX_DEPTH: u32 = 40;
 
-/// A point with the values of F, F' and F'' there.
+/// A point with sin and cos of it and the values of F, F' and F'' there.
 #[derive(Debug, Clone, Copy)]
 struct Pt {
     x: f64,
+    sin: f64,
+    cos: f64,
     f: f64,
     d: f64,
     s: f64,
@@ -324,7 +377,7 @@ struct Isolation {
     ef: f64,
     ed: f64,
     es: f64,
-    out: ArrayVec<f64, MAX_TRIG_ROOTS>,
+    out: ArrayVec<TrigRoot, MAX_TRIG_ROOTS>,
     /// The polynomial as given, and its half-angle charts (computed when needed).
     orig: Trig,
     charts: [Option<Coeffs>; 2],
@@ -338,42 +391,54 @@ impl Isolation {
         self.at_sc(x, s1, c1)
     }
 
-    /// [`Isolation::at`] along a Newton iteration: sin and cos of x from those of the previous
-    /// point when it is close ([`sin_cos_after_step`]), kept in `last`.
+    /// sin and cos of x along a Newton iteration: from those of the previous point when it is
+    /// close ([`sin_cos_after_step`]), kept in `last`.
     #[inline]
-    fn at_following(&self, x: f64, last: &std::cell::Cell<Option<(f64, f64, f64)>>) -> Pt {
+    fn sin_cos_following(x: f64, last: &std::cell::Cell<Option<(f64, f64, f64)>>) -> (f64, f64) {
         let (s1, c1) = match last.get() {
             Some((x0, s0, c0)) => sin_cos_after_step(s0, c0, x, x0 - x),
             None => x.sin_cos(),
         };
         last.set(Some((x, s1, c1)));
+        (s1, c1)
+    }
+
+    /// [`Isolation::at`] along a Newton iteration ([`Isolation::sin_cos_following`]).
+    #[inline]
+    fn at_following(&self, x: f64, last: &std::cell::Cell<Option<(f64, f64, f64)>>) -> Pt {
+        let (s1, c1) = Self::sin_cos_following(x, last);
         self.at_sc(x, s1, c1)
+    }
+
+    /// g and h (two of F, F', F'') at x along a Newton iteration, without the third.
+    #[inline]
+    fn pair_following(
+        x: f64,
+        last: &std::cell::Cell<Option<(f64, f64, f64)>>,
+        g: &Trig,
+        h: &Trig,
+    ) -> (f64, f64) {
+        let (s1, c1) = Self::sin_cos_following(x, last);
+        let (c, s) = harmonics(s1, c1);
+        (dot_harmonics(g, &c, &s), dot_harmonics(h, &c, &s))
     }
 
     #[inline]
     fn at_sc(&self, x: f64, s1: f64, c1: f64) -> Pt {
-        let (c2, s2) = (c1 * c1 - s1 * s1, 2.0 * s1 * c1);
-        let (c3, s3) = (c2 * c1 - s2 * s1, s2 * c1 + c2 * s1);
-        let (c4, s4) = (c2 * c2 - s2 * s2, 2.0 * s2 * c2);
-        let (c, s) = ([c1, c2, c3, c4], [s1, s2, s3, s4]);
-        let dot = |t: &Trig| {
-            let mut acc = t.cos[0];
-            for k in 0..MAX_HARMONIC {
-                acc += t.cos[k + 1] * c[k] + t.sin[k + 1] * s[k];
-            }
-            acc
-        };
+        let (c, s) = harmonics(s1, c1);
         Pt {
             x,
-            f: dot(&self.f),
-            d: dot(&self.d),
-            s: dot(&self.s),
+            sin: s1,
+            cos: c1,
+            f: dot_harmonics(&self.f, &c, &s),
+            d: dot_harmonics(&self.d, &c, &s),
+            s: dot_harmonics(&self.s, &c, &s),
         }
     }
 
-    fn push(&mut self, x: f64) {
+    fn push(&mut self, x: f64, (sin, cos): (f64, f64)) {
         if !self.out.is_full() {
-            self.out.push(x);
+            self.out.push(TrigRoot { x, sin, cos });
         }
     }
 
@@ -446,7 +511,7 @@ impl Isolation {
         let (lo, hi) = ((t(xa) - 1e-12).max(-1.0), (t(xb) + 1e-12).min(1.0));
         for r in crate::poly::roots_in(poly, lo, hi) {
             let x = 2.0 * r.x.atan() + centre;
-            self.push(x);
+            self.push(x, x.sin_cos());
         }
     }
 
@@ -454,25 +519,42 @@ impl Isolation {
     fn monotone(&mut self, a: Pt, b: Pt) {
         if opposite_beyond(a.f, b.f, self.ef) {
             let start = root_start(a, b);
-            let last = std::cell::Cell::new(None);
+            let last = std::cell::Cell::new(Some((a.x, a.sin, a.cos)));
             let x = newton_bracketed(a.x, b.x, a.f, start, self.m2, |x| {
-                let p = self.at_following(x, &last);
-                (p.f, p.d)
+                Self::pair_following(x, &last, &self.f, &self.d)
             });
-            self.push(x);
+            self.push(x, Self::sin_cos_following(x, &last));
         }
     }
 
     /// The single root of F' on [a.x, b.x] (F' strictly monotone, changing sign), with F there.
     fn critical(&self, a: Pt, b: Pt) -> Pt {
         let start = hermite_start(a.x, b.x, a.d, b.d, a.s, b.s);
-        let last = std::cell::Cell::new(None);
+        let last = std::cell::Cell::new(Some((a.x, a.sin, a.cos)));
         let x = newton_bracketed(a.x, b.x, a.d, start, self.m3, |x| {
-            let p = self.at_following(x, &last);
-            (p.d, p.s)
+            Self::pair_following(x, &last, &self.d, &self.s)
         });
         self.at_following(x, &last)
     }
+}
+
+/// cos k x and sin k x, k = 1..=4, from sin x and cos x (angle-sum recurrences).
+#[inline]
+fn harmonics(s1: f64, c1: f64) -> ([f64; MAX_HARMONIC], [f64; MAX_HARMONIC]) {
+    let (c2, s2) = (c1 * c1 - s1 * s1, 2.0 * s1 * c1);
+    let (c3, s3) = (c2 * c1 - s2 * s1, s2 * c1 + c2 * s1);
+    let (c4, s4) = (c2 * c2 - s2 * s2, 2.0 * s2 * c2);
+    ([c1, c2, c3, c4], [s1, s2, s3, s4])
+}
+
+/// t(x) from the harmonics of x ([`harmonics`]).
+#[inline]
+fn dot_harmonics(t: &Trig, c: &[f64; MAX_HARMONIC], s: &[f64; MAX_HARMONIC]) -> f64 {
+    let mut acc = t.cos[0];
+    for k in 0..MAX_HARMONIC {
+        acc += t.cos[k + 1] * c[k] + t.sin[k + 1] * s[k];
+    }
+    acc
 }
 
 /// A start for the root of F, monotone on [a.x, b.x] and changing sign there: the inverse
