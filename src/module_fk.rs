@@ -127,15 +127,15 @@ impl Elimination {
         alpha: f64,
         (s, c): (f64, f64),
     ) -> Option<ModulePose> {
-        let det = self.det.eval_sc(s, c);
+        let det = self.det.eval_sc_deg::<1>(s, c);
         let det_scale = self.det.cos[0].abs() + self.det.cos[1].abs() + self.det.sin[1].abs();
         if det.abs() <= FK_DET_REL * det_scale || det_scale == 0.0 {
             return None;
         }
-        let b = self.b.eval_sc(s, c);
+        let b = self.b.eval_sc_deg::<1>(s, c);
         let y = -g.r_big1 * s * b / det;
-        let zp = self.w.eval_sc(s, c) * b / det;
-        let u = self.u_num.eval_sc(s, c) / (2.0 * self.delta * det);
+        let zp = self.w.eval_sc_deg::<1>(s, c) * b / det;
+        let u = self.u_num.eval_sc_deg::<2>(s, c) / (2.0 * self.delta * det);
         Some(ModulePose {
             p: Vector3::new(u - g.dx1, y, zp + rho.x),
             alpha,
@@ -152,8 +152,13 @@ pub fn characteristic(g: &ModuleGeometry, rho: &Sliders) -> Trig {
 /// Points P on all four spheres of eqs. (3)-(6) at a fixed alpha: three sphere differences are
 /// planes; a unique point when they meet in one, and up to two points when they share a line
 /// (the degenerate case of condition (21)).
-fn fixed_alpha_points(g: &ModuleGeometry, rho: &Sliders, alpha: f64) -> ArrayVec<ModulePose, 2> {
-    let (s, c) = alpha.sin_cos();
+/// (s, c) = sin, cos of alpha.
+fn fixed_alpha_points(
+    g: &ModuleGeometry,
+    rho: &Sliders,
+    alpha: f64,
+    (s, c): (f64, f64),
+) -> ArrayVec<ModulePose, 2> {
     let (r, rr, r2, r4) = (g.r_big1, g.r_small1, g.r_big2, g.r4);
     let centers = [
         Vector3::new(-g.dx1, rr - r * c, rho.x - r * s),
@@ -217,21 +222,24 @@ fn fixed_alpha_points(g: &ModuleGeometry, rho: &Sliders, alpha: f64) -> ArrayVec
     out
 }
 
-/// The angles where Det = A cos(alpha) + B sin(alpha) + C vanishes (condition (21)): none, one
-/// or two; none when Det is identically zero or never zero.
-fn det_zeros(det: &Trig) -> ArrayVec<f64, 2> {
+/// (sin alpha, cos alpha) where Det = A cos(alpha) + B sin(alpha) + C vanishes (condition
+/// (21)): the line A c + B s + C = 0 met with the unit circle, without trigonometric calls; none,
+/// one or two; none when Det is identically zero or never zero.
+fn det_zeros(det: &Trig) -> ArrayVec<(f64, f64), 2> {
     let (a, b, c) = (det.cos[1], det.sin[1], det.cos[0]);
-    let r = a.hypot(b);
+    let r2 = a * a + b * b;
     let mut out = ArrayVec::new();
-    if r == 0.0 || !r.is_finite() || c.abs() > r {
+    if r2 == 0.0 || !r2.is_finite() || c * c > r2 {
         return out;
     }
-    // A cos + B sin = r cos(alpha - phi) = -C.
-    let phi = b.atan2(a);
-    let d = (-c / r).clamp(-1.0, 1.0).acos();
-    out.push(wrap_angle(phi - d));
-    if d != 0.0 {
-        out.push(wrap_angle(phi + d));
+    // The foot of the perpendicular from the origin, -C (A, B) / r^2, plus or minus the half
+    // chord sqrt(r^2 - C^2) along (-B, A) / r.
+    let h = (r2 - c * c).sqrt();
+    let (foot_c, foot_s) = (-c * a / r2, -c * b / r2);
+    let (along_c, along_s) = (-b * h / r2, a * h / r2);
+    out.push((foot_s - along_s, foot_c - along_c));
+    if h != 0.0 {
+        out.push((foot_s + along_s, foot_c + along_c));
     }
     out
 }
@@ -253,7 +261,7 @@ pub fn solve(m: &Machine, rho: &Sliders) -> FkModes {
         match elim.back_substitute(g, rho, alpha, sc) {
             Some(p) => starts.push((p, sc)),
             None => starts.extend(
-                fixed_alpha_points(g, rho, alpha)
+                fixed_alpha_points(g, rho, alpha, sc)
                     .into_iter()
                     .map(|p| (p, sc)),
             ),
@@ -266,13 +274,13 @@ pub fn solve(m: &Machine, rho: &Sliders) -> FkModes {
     // keeping only points that already solve them (elsewhere Newton could wander from these
     // least-squares points and stop, unconverged, next to a solution found above).
     let b_scale = elim.b.cos[0].abs() + elim.b.sin[1].abs();
-    for alpha in det_zeros(&elim.det) {
+    for sc in det_zeros(&elim.det) {
         // F = 4 b^2 (Q^2 + delta^2 N) > 0 there unless b = 0: no solution at this alpha.
-        if elim.b.eval(alpha).abs() > DET_ZERO_B_REL * b_scale {
+        if elim.b.eval_sc_deg::<1>(sc.0, sc.1).abs() > DET_ZERO_B_REL * b_scale {
             continue;
         }
-        let sc = alpha.sin_cos();
-        let on_spheres = fixed_alpha_points(g, rho, alpha)
+        let alpha = wrap_angle(sc.0.atan2(sc.1));
+        let on_spheres = fixed_alpha_points(g, rho, alpha, sc)
             .into_iter()
             .filter(|p| residual_mm(g, p, rho) <= ACCEPT_RESIDUAL_MM)
             .map(|p| (p, sc));

@@ -77,9 +77,22 @@ impl Trig {
     /// The value at x from (sin x, cos x).
     #[inline]
     pub fn eval_sc(&self, s1: f64, c1: f64) -> f64 {
+        self.eval_sc_up_to(s1, c1, MAX_HARMONIC)
+    }
+
+    /// [`Trig::eval_sc`] of a form of degree at most `D` (the terms left out are zero: the same
+    /// value).
+    #[inline]
+    pub fn eval_sc_deg<const D: usize>(&self, s1: f64, c1: f64) -> f64 {
+        debug_assert!(self.degree() <= D);
+        self.eval_sc_up_to(s1, c1, D.min(MAX_HARMONIC))
+    }
+
+    #[inline(always)]
+    fn eval_sc_up_to(&self, s1: f64, c1: f64, degree: usize) -> f64 {
         let (mut ck, mut sk) = (1.0, 0.0);
         let mut acc = self.cos[0];
-        for k in 1..=MAX_HARMONIC {
+        for k in 1..=degree {
             let c = ck * c1 - sk * s1;
             sk = sk * c1 + ck * s1;
             ck = c;
@@ -185,6 +198,16 @@ impl Trig {
     }
 
     /// p at the grid points x_j.
+    /// The value at grid point j, as [`Trig::on_grid`] computes it (same sums, same order).
+    #[inline]
+    fn at_grid(&self, j: usize) -> f64 {
+        let mut v = self.cos[0];
+        for k in 0..MAX_HARMONIC {
+            v += self.cos[k + 1] * GRID_COS[k][j] + self.sin[k + 1] * GRID_SIN[k][j];
+        }
+        v
+    }
+
     fn on_grid(&self) -> [f64; GRID] {
         let mut v = [self.cos[0]; GRID];
         for k in 0..MAX_HARMONIC {
@@ -237,17 +260,23 @@ impl Trig {
             orig: *self,
             charts: [None, None],
         };
-        let (fv, dv, sv) = (f.on_grid(), d.on_grid(), s.on_grid());
+        // F on the whole grid; F' and F'' only at the ends of the intervals that F alone does not
+        // prove root-free (few: about two per root).
+        let fv = f.on_grid();
         let step = std::f64::consts::PI / 16.0;
         let pt = |j: usize| Pt {
             x: (j as f64 - 16.0) * step,
             sin: GRID_SIN[0][j % GRID],
             cos: GRID_COS[0][j % GRID],
             f: fv[j % GRID],
-            d: dv[j % GRID],
-            s: sv[j % GRID],
+            d: d.at_grid(j % GRID),
+            s: s.at_grid(j % GRID),
         };
+        let root_free = step * step * 0.125 * iso.m2 + iso.ef;
         for j in 0..GRID {
+            if same_sign_beyond(fv[j], fv[(j + 1) % GRID], root_free) {
+                continue;
+            }
             let (a, b) = (pt(j), pt(j + 1));
             let found = iso.out.len();
             let near_zero = a.f.abs() <= iso.ef || b.f.abs() <= iso.ef;
