@@ -266,7 +266,7 @@ impl Leg1Equations {
 
     /// The Newton step from `cur` (residuals f, dz = z - rho1), and whether it settles the
     /// posture; None on a singular Jacobian.
-    #[inline]
+    #[inline(always)]
     fn newton_step(&self, cur: &Leg1, f: [f64; 2], dz: f64) -> Option<(Leg1, bool)> {
         let (r, rr, y) = (self.r, self.rr, self.y);
         // Jacobian of (g1, g2) in (alpha, rho1), solved by Cramer's rule.
