@@ -125,12 +125,66 @@ impl fmt::Display for Verdict {
     }
 }
 
-/// What one leg contributes to a branch's label and verdict: its configuration index s_i
-/// (eqs. (11)-(13)) and its reasons (inverted, stroke, rod tilt). `cos_tilt_max` is
-/// cos(rod_tilt_max + slack): a rod is too tilted when v_z < cos_tilt_max |v|, which avoids an
-/// acos per rod. (s, c) = sin, cos of alpha.
+/// What one leg contributes to a branch's label and verdict: the signed quantity whose sign is
+/// its configuration index s_i (eqs. (11)-(13): rho1 - zp, rho2 - zp + R2 sin(alpha),
+/// rho3 - zp - R2 sin(alpha)), whether a rod is tilted beyond the passive joints' limit, and
+/// whether the slider is outside its stroke.
+#[derive(Debug, Clone, Copy)]
+pub struct LegState {
+    leg: usize,
+    q: f64,
+    tilted: bool,
+    outside_stroke: bool,
+}
+
+impl LegState {
+    /// The configuration index s_i.
+    #[inline]
+    pub fn sign(self) -> i8 {
+        if self.q > CONFIG_SIGN_MM { 1 } else { -1 }
+    }
+
+    /// The leg's reasons (inverted, stroke, rod tilt).
+    #[inline]
+    pub fn verdict(self) -> Verdict {
+        let mut v = Verdict::default();
+        if self.sign() != -1 {
+            v.add(
+                [
+                    Reason::Leg1Inverted,
+                    Reason::Leg2Inverted,
+                    Reason::Leg3Inverted,
+                ][self.leg],
+            );
+        }
+        if self.outside_stroke {
+            v.add([Reason::Rho1Stroke, Reason::Rho2Stroke, Reason::Rho3Stroke][self.leg]);
+        }
+        if self.tilted {
+            v.add(Reason::RodTilt);
+        }
+        v
+    }
+
+    /// Label and verdict.
+    #[inline]
+    pub fn check(self) -> (i8, Verdict) {
+        (self.sign(), self.verdict())
+    }
+
+    /// Nothing against the leg: [`LegState::verdict`] is empty (without building it).
+    #[inline]
+    pub fn ok(self) -> bool {
+        let inverted = self.q > CONFIG_SIGN_MM;
+        !inverted && !self.tilted && !self.outside_stroke
+    }
+}
+
+/// Leg `leg` (0, 1, 2) at slider position `rho_i` with P = `p`; (s, c) = sin, cos of alpha.
+/// `cos_tilt_max` is cos(rod_tilt_max + slack): a rod is too tilted when v_z < cos_tilt_max |v|,
+/// which avoids an acos per rod.
 #[inline]
-pub fn leg_check(
+pub fn leg_state(
     m: &Machine,
     leg: usize,
     p: &nalgebra::Vector3<f64>,
@@ -138,63 +192,7 @@ pub fn leg_check(
     c: f64,
     rho_i: f64,
     cos_tilt_max: f64,
-) -> (i8, Verdict) {
-    let mut v = Verdict::default();
-    let (q, tilted) = leg_state(m, leg, p, s, c, rho_i, cos_tilt_max);
-    let sign = if q > CONFIG_SIGN_MM { 1 } else { -1 };
-    if sign != -1 {
-        v.add(
-            [
-                Reason::Leg1Inverted,
-                Reason::Leg2Inverted,
-                Reason::Leg3Inverted,
-            ][leg],
-        );
-    }
-    if outside_stroke(m, leg, rho_i) {
-        v.add([Reason::Rho1Stroke, Reason::Rho2Stroke, Reason::Rho3Stroke][leg]);
-    }
-    if tilted {
-        v.add(Reason::RodTilt);
-    }
-    (sign, v)
-}
-
-/// True when [`leg_check`] finds nothing against the leg: s_i = -1, inside its stroke, rods not
-/// too tilted (without building the verdict).
-#[inline]
-pub fn leg_ok(
-    m: &Machine,
-    leg: usize,
-    p: &nalgebra::Vector3<f64>,
-    s: f64,
-    c: f64,
-    rho_i: f64,
-    cos_tilt_max: f64,
-) -> bool {
-    let (q, tilted) = leg_state(m, leg, p, s, c, rho_i, cos_tilt_max);
-    let inverted = q > CONFIG_SIGN_MM;
-    !inverted && !tilted && !outside_stroke(m, leg, rho_i)
-}
-
-#[inline]
-fn outside_stroke(m: &Machine, leg: usize, rho_i: f64) -> bool {
-    rho_i < m.limits.rho_min[leg] - LIMIT_SLACK || rho_i > m.limits.rho_max[leg] + LIMIT_SLACK
-}
-
-/// The signed quantity whose sign is the leg's configuration index (rho1 - zp,
-/// rho2 - zp + R2 sin(alpha), rho3 - zp - R2 sin(alpha)), and whether one of its rods is tilted
-/// beyond the limit.
-#[inline]
-fn leg_state(
-    m: &Machine,
-    leg: usize,
-    p: &nalgebra::Vector3<f64>,
-    s: f64,
-    c: f64,
-    rho_i: f64,
-    cos_tilt_max: f64,
-) -> (f64, bool) {
+) -> LegState {
     let g = &m.module;
     // r.z < cos_tilt_max |r|, squared (no square root).
     let ct2 = cos_tilt_max * cos_tilt_max;
@@ -206,7 +204,7 @@ fn leg_state(
             r.z < 0.0 && zz > ct2 * r.norm_squared()
         }
     };
-    match leg {
+    let (q, tilted) = match leg {
         0 => {
             let (dy, dz) = (g.r_big1 * c - g.r_small1, g.r_big1 * s);
             let u = p.x + g.dx1;
@@ -230,10 +228,18 @@ fn leg_state(
             );
             (rho_i - p.z - g.r_big2 * s, too_tilted(r6))
         }
+    };
+    let outside_stroke =
+        rho_i < m.limits.rho_min[leg] - LIMIT_SLACK || rho_i > m.limits.rho_max[leg] + LIMIT_SLACK;
+    LegState {
+        leg,
+        q,
+        tilted,
+        outside_stroke,
     }
 }
 
-/// cos of the largest rod tilt with its slack, for [`leg_check`].
+/// cos of the largest rod tilt with its slack, for [`leg_state`].
 pub fn cos_tilt_max(m: &Machine) -> f64 {
     m.limits.cos_rod_tilt_max
 }
@@ -259,7 +265,8 @@ pub fn label(
     rho: &Sliders,
 ) -> (Config, Verdict) {
     let ct = cos_tilt_max(m);
-    let legs: [(i8, Verdict); 3] = std::array::from_fn(|i| leg_check(m, i, p, s, c, rho[i], ct));
+    let legs: [(i8, Verdict); 3] =
+        std::array::from_fn(|i| leg_state(m, i, p, s, c, rho[i], ct).check());
     (
         [legs[0].0, legs[1].0, legs[2].0],
         combine(m, c, [legs[0].1, legs[1].1, legs[2].1]),
@@ -272,7 +279,7 @@ pub fn module_verdict(m: &Machine, pose: &ModulePose, rho: &Sliders, config: Con
     let (s, c) = pose.alpha.sin_cos();
     let ct = cos_tilt_max(m);
     let legs: [Verdict; 3] = std::array::from_fn(|i| {
-        let (_, mut v) = leg_check(m, i, &pose.p, s, c, rho[i], ct);
+        let mut v = leg_state(m, i, &pose.p, s, c, rho[i], ct).verdict();
         // The configuration given wins over the recomputed sign (they agree up to rounding).
         for r in [
             Reason::Leg1Inverted,

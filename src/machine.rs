@@ -33,7 +33,7 @@ pub struct Limits {
     /// Largest angle between a rod and the vertical slider axis (rad).
     pub rod_tilt_max: f64,
     /// cos(rod_tilt_max + LIMIT_SLACK), derived from it when the machine is read: the rod-tilt
-    /// test compares cosines ([`crate::branches::leg_check`]).
+    /// test compares cosines ([`crate::branches::leg_state`]).
     pub cos_rod_tilt_max: f64,
     pub theta1_min: f64,
     pub theta1_max: f64,

@@ -7,7 +7,7 @@
 use arrayvec::ArrayVec;
 use nalgebra::Vector3;
 
-use crate::branches::{Config, Verdict, WORKING_CONFIG, combine, cos_tilt_max, leg_check, leg_ok};
+use crate::branches::{Config, Verdict, WORKING_CONFIG, combine, cos_tilt_max, leg_state};
 use crate::cubic::cubic_roots_in;
 use crate::machine::{Machine, ModuleGeometry};
 use crate::module_geometry::Sliders;
@@ -369,7 +369,7 @@ pub fn solve_into(m: &Machine, p: &Vector3<f64>, out: &mut IkBranches) {
     let n = legs1.len();
     let mut checks = [(0i8, Verdict::default()); 6];
     for (k, l) in legs1.iter().enumerate() {
-        checks[k] = leg_check(m, 0, p, l.sin, l.cos, l.rho1, cos_tilt);
+        checks[k] = leg_state(m, 0, p, l.sin, l.cos, l.rho1, cos_tilt).check();
     }
     // Postures come in pairs (alpha >= 0, its mirror) by increasing cos(alpha): the mirrors in
     // that order, then the others in reverse, is usually the order already; sorted if not.
@@ -405,7 +405,7 @@ pub fn solve_into(m: &Machine, p: &Vector3<f64>, out: &mut IkBranches) {
             continue;
         };
         // Labels and verdicts leg by leg: leg I once per posture, legs II and III once per root.
-        let leg = |i: usize, rho_i: f64| leg_check(m, i, p, s, c, rho_i, cos_tilt);
+        let leg = |i: usize, rho_i: f64| leg_state(m, i, p, s, c, rho_i, cos_tilt).check();
         let l2 = [leg(1, r2[0]), leg(1, r2[1])];
         let l3 = [leg(2, r3[0]), leg(2, r3[1])];
         for (k2, rho2) in r2.into_iter().enumerate() {
@@ -517,10 +517,10 @@ pub(crate) fn working_on_posture(
         return Ok(None);
     };
     // Feasible: every leg as on the machine and inside its limits, rods of leg I not crossing
-    // (what [`combine`] of the three [`leg_check`]s says, without building the verdict).
-    let feasible = leg_ok(m, 0, p, s, c, leg1.rho1, cos_tilt)
-        && leg_ok(m, 1, p, s, c, rho2, cos_tilt)
-        && leg_ok(m, 2, p, s, c, rho3, cos_tilt)
+    // (what [`combine`] of the three legs' verdicts says, without building it).
+    let feasible = leg_state(m, 0, p, s, c, leg1.rho1, cos_tilt).ok()
+        && leg_state(m, 1, p, s, c, rho2, cos_tilt).ok()
+        && leg_state(m, 2, p, s, c, rho3, cos_tilt).ok()
         && g.r_big1 * c > g.r_small1;
     Ok(feasible.then_some(IkBranch {
         alpha: leg1.alpha,

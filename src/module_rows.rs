@@ -51,20 +51,14 @@ impl RowJob for ModuleIk {
     where
         IkBranches: 'a,
     {
-        if self.all {
-            for (inputs, solved) in rows {
-                if let Some(v) = inputs {
-                    self.solve(v, solved);
-                }
-            }
-            return;
-        }
         let mut tracker = IkTracker::new(&self.machine);
-        for (inputs, solved) in rows {
-            if let Some(v) = inputs {
+        solve_rows(rows, |v, solved| {
+            if self.all {
+                self.solve(v, solved);
+            } else {
                 tracker.working_into(&Vector3::new(v[0], v[1], v[2]), solved);
             }
-        }
+        });
     }
 
     fn emit(&mut self, b: &IkBranches, out: &mut RowWriter<'_>) -> Result<RowOutcome, VerneError> {
@@ -77,6 +71,18 @@ impl RowJob for ModuleIk {
             ];
             (values, br.config, br.verdict)
         })
+    }
+}
+
+/// Solves each row of a run that has its inputs, in order (rows without are left as they are).
+fn solve_rows<'a, T: 'a>(
+    rows: &mut dyn Iterator<Item = (Option<&'a [f64]>, &'a mut T)>,
+    mut solve: impl FnMut(&[f64], &mut T),
+) {
+    for (inputs, solved) in rows {
+        if let Some(v) = inputs {
+            solve(v, solved);
+        }
     }
 }
 
@@ -181,20 +187,14 @@ impl RowJob for ModuleFk {
     where
         FkModes: 'a,
     {
-        if self.all {
-            for (inputs, solved) in rows {
-                if let Some(v) = inputs {
-                    self.solve(v, solved);
-                }
-            }
-            return;
-        }
         let mut tracker = FkTracker::new(&self.machine);
-        for (inputs, solved) in rows {
-            if let Some(v) = inputs {
+        solve_rows(rows, |v, solved| {
+            if self.all {
+                self.solve(v, solved);
+            } else {
                 tracker.working_into(&Vector3::new(v[0], v[1], v[2]), solved);
             }
-        }
+        });
     }
 
     fn emit(&mut self, modes: &FkModes, out: &mut RowWriter<'_>) -> Result<RowOutcome, VerneError> {

@@ -24,6 +24,20 @@ impl Lcg {
     }
 }
 
+/// `n` deterministic points in a box around the reachable space.
+fn random_points(seed: u64, n: usize) -> Vec<Vector3<f64>> {
+    let mut r = Lcg(seed);
+    (0..n)
+        .map(|_| {
+            Vector3::new(
+                -700.0 + 1200.0 * r.unit(),
+                -600.0 + 1200.0 * r.unit(),
+                400.0 + 1300.0 * r.unit(),
+            )
+        })
+        .collect()
+}
+
 #[derive(Default, Debug)]
 struct Tally {
     points: usize,
@@ -105,17 +119,7 @@ fn working_fast_matches_the_complete_solver_on_a_grid() {
 #[test]
 fn working_fast_matches_the_complete_solver_on_random_points() {
     let m = Machine::default_verne();
-    let mut r = Lcg(7);
-    let pts: Vec<Vector3<f64>> = (0..50_000)
-        .map(|_| {
-            Vector3::new(
-                -700.0 + 1200.0 * r.unit(),
-                -600.0 + 1200.0 * r.unit(),
-                400.0 + 1300.0 * r.unit(),
-            )
-        })
-        .collect();
-    check(pts.into_iter(), &m);
+    check(random_points(7, 50_000).into_iter(), &m);
 }
 
 /// Points on and within 1e-12..1e-3 of the places where the fast path must hand over: y_p = 0
@@ -336,16 +340,7 @@ fn tracked_ik_matches_the_complete_solver_along_a_helix() {
 #[test]
 fn tracked_ik_matches_the_complete_solver_on_scattered_points() {
     let m = Machine::default_verne();
-    let mut r = Lcg(5);
-    let pts: Vec<Vector3<f64>> = (0..20_000)
-        .map(|_| {
-            Vector3::new(
-                -700.0 + 1200.0 * r.unit(),
-                -600.0 + 1200.0 * r.unit(),
-                400.0 + 1300.0 * r.unit(),
-            )
-        })
-        .collect();
+    let pts = random_points(5, 20_000);
     let (present, tracked) = ik_tracked_agrees(&m, &pts);
     eprintln!("{present} with a working branch, {tracked} tracked");
     assert!(present > 1000);
