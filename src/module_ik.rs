@@ -408,16 +408,20 @@ pub fn solve_into(m: &Machine, p: &Vector3<f64>, out: &mut IkBranches) {
         let leg = |i: usize, rho_i: f64| leg_state(m, i, p, s, c, rho_i, cos_tilt).check();
         let l2 = [leg(1, r2[0]), leg(1, r2[1])];
         let l3 = [leg(2, r3[0]), leg(2, r3[1])];
-        for (k2, rho2) in r2.into_iter().enumerate() {
-            for (k3, rho3) in r3.into_iter().enumerate() {
-                out.push(IkBranch {
-                    alpha: leg1.alpha,
-                    rho: Sliders::new(leg1.rho1, rho2, rho3),
-                    config: [l1.0, l2[k2].0, l3[k3].0],
-                    verdict: combine(m, c, [l1.1, l2[k2].1, l3[k3].1]),
-                });
+        let four: [IkBranch; 4] = std::array::from_fn(|k| {
+            let (k2, k3) = (k / 2, k % 2);
+            IkBranch {
+                alpha: leg1.alpha,
+                rho: Sliders::new(leg1.rho1, r2[k2], r3[k3]),
+                config: [l1.0, l2[k2].0, l3[k3].0],
+                verdict: combine(m, c, [l1.1, l2[k2].1, l3[k3].1]),
             }
-        }
+        });
+        let pushed = out.try_extend_from_slice(&four);
+        debug_assert!(
+            pushed.is_ok(),
+            "six postures of four branches fit MAX_IK_BRANCHES"
+        );
     }
 }
 
