@@ -18,8 +18,8 @@ use nalgebra::Vector3;
 use crate::branches::cos_tilt_max;
 use crate::machine::Machine;
 use crate::module_ik::{
-    self, FAST_MARGIN_MM, FAST_MARGIN_RAD, IkBranches, Leg1, eq9_coefficients, newton_leg1,
-    working_on_posture,
+    self, FAST_MARGIN_MM, FAST_MARGIN_RAD, IkBranch, IkBranches, Leg1, eq9_coefficients,
+    newton_leg1, working_on_posture,
 };
 use crate::trig::sin_cos_after_step;
 
@@ -77,13 +77,9 @@ impl<'m> IkTracker<'m> {
         });
     }
 
-    fn track(&mut self, p: &Vector3<f64>) -> Option<module_ik::IkBranch> {
+    fn track(&mut self, p: &Vector3<f64>) -> Option<IkBranch> {
         let m = self.machine;
-        let g = &m.module;
         let prev = self.last.take()?;
-        if !p.iter().all(|v| v.is_finite()) || !isolated_working_root(m, p) {
-            return None;
-        }
         // Start from the previous posture, extrapolated along the path (quadratically from three
         // rows, linearly from two): Newton then needs one step.
         let (a1, r1) = (prev.alpha, prev.rho1);
@@ -104,20 +100,37 @@ impl<'m> IkTracker<'m> {
             }
             None => prev,
         };
-        let leg1 = newton_leg1(g, p, start)?;
-        // The posture must be a root with R1 cos(alpha) > r1, away from alpha = 0 (where the
-        // two postures of a root meet) and with s1 = -1 by a margin.
-        let clear = g.r_big1 * leg1.cos - g.r_small1 > FAST_MARGIN_MM
-            && leg1.sin.abs() > FAST_MARGIN_RAD
-            && leg1.rho1 - p.z < -FAST_MARGIN_MM;
-        if !clear {
-            return None;
-        }
-        let branch = working_on_posture(m, p, &leg1, self.cos_tilt).ok()??;
+        let (branch, leg1) = certified_working(m, p, start, self.cos_tilt)?;
         self.history = [Some((a1, r1)), self.history[0]];
         self.last = Some(leg1);
         Some(branch)
     }
+}
+
+/// The working branch for `p` by Newton on leg I from `start`, when the result is certified (see
+/// the module documentation), with its leg-I posture; None when unsure, or when the branch found
+/// is not feasible (the per-point solution then says why).
+pub(crate) fn certified_working(
+    m: &Machine,
+    p: &Vector3<f64>,
+    start: Leg1,
+    cos_tilt: f64,
+) -> Option<(IkBranch, Leg1)> {
+    let g = &m.module;
+    if !p.iter().all(|v| v.is_finite()) || !isolated_working_root(m, p) {
+        return None;
+    }
+    let leg1 = newton_leg1(g, p, start)?;
+    // The posture must be a root with R1 cos(alpha) > r1, away from alpha = 0 (where the two
+    // postures of a root meet) and with s1 = -1 by a margin.
+    let clear = g.r_big1 * leg1.cos - g.r_small1 > FAST_MARGIN_MM
+        && leg1.sin.abs() > FAST_MARGIN_RAD
+        && leg1.rho1 - p.z < -FAST_MARGIN_MM;
+    if !clear {
+        return None;
+    }
+    let branch = working_on_posture(m, p, &leg1, cos_tilt).ok()??;
+    Some((branch, leg1))
 }
 
 /// True when the cubic (9) of `p` has at most one root with cos(alpha) in [r1/R1, 1] (slightly

@@ -442,6 +442,9 @@ pub fn working_fast(m: &Machine, p: &Vector3<f64>) -> Option<IkBranch> {
     if !p.iter().all(|v| v.is_finite()) {
         return None;
     }
+    if let Some((branch, _)) = certified_from_estimate(m, p) {
+        return Some(branch);
+    }
     let coeffs = cubic_eq9(g, p)?;
     let (r, rr) = (g.r_big1, g.r_small1);
     let lo = (rr / r - FAST_MARGIN_RAD).max(-1.0);
@@ -532,6 +535,29 @@ pub(crate) fn working_on_posture(
         config: WORKING_CONFIG,
         verdict: Verdict::default(),
     }))
+}
+
+/// [`crate::ik_track::certified_working`] from a start estimated without root isolation: eq.
+/// (14) to first order about alpha = 0 (sin(alpha) = -y (R1 - r1) / (R1 h), h = |z - rho1| from
+/// eq. (11) at cos(alpha) = 1), rho1 below zp by eq. (11) there. No cubic and no `acos` when
+/// Newton reaches the certified posture.
+fn certified_from_estimate(m: &Machine, p: &Vector3<f64>) -> Option<(IkBranch, Leg1)> {
+    let g = &m.module;
+    let (r, rr) = (g.r_big1, g.r_small1);
+    let h0 = leg1_height_sq(g, p, 1.0);
+    if p.y.abs() < FAST_MARGIN_MM || h0 <= 0.0 {
+        return None;
+    }
+    // Small enough for the series of sin_cos_after_step (|alpha| < 0.25).
+    let alpha = (-p.y * (r - rr) / (r * h0.sqrt())).clamp(-0.24, 0.24);
+    let (sin, cos) = sin_cos_after_step(0.0, 1.0, alpha, -alpha);
+    let start = Leg1 {
+        alpha,
+        rho1: p.z - leg1_height_sq(g, p, cos).max(1.0).sqrt(),
+        sin,
+        cos,
+    };
+    crate::ik_track::certified_working(m, p, start, cos_tilt_max(m))
 }
 
 /// What `verne ik` needs for one point: the working branch alone when [`working_fast`] is sure
