@@ -27,6 +27,11 @@ use crate::trig::sin_cos_after_step;
 /// [r1/R1, 1] for the root there to count as isolated.
 const MONOTONE_MARGIN: f64 = 1e-9;
 
+/// Newton steps allowed to settle leg I from a start (the previous rows' extrapolation, or the
+/// per-point estimate): two or three from either on a path or a grid; more means the start was
+/// poor and the per-point solution answers.
+const LEG1_MAX_STEPS: usize = 6;
+
 /// Follows the working branch from row to row; one per run of consecutive rows.
 pub struct IkTracker<'m> {
     machine: &'m Machine,
@@ -120,7 +125,7 @@ pub(crate) fn certified_working(
     if !p.iter().all(|v| v.is_finite()) || !isolated_working_root(m, p) {
         return None;
     }
-    let leg1 = newton_leg1(g, p, start)?;
+    let leg1 = newton_leg1(g, p, start, LEG1_MAX_STEPS)?;
     // The posture must be a root with R1 cos(alpha) > r1, away from alpha = 0 (where the two
     // postures of a root meet) and with s1 = -1 by a margin.
     let clear = g.r_big1 * leg1.cos - g.r_small1 > FAST_MARGIN_MM

@@ -155,25 +155,17 @@ const PREDICTED_STEP_FRACTION: f64 = 1e-3;
 
 /// Newton on g1 = u^2 + y^2 + (z - rho1)^2 - K1(alpha) (eq. (10)) and
 /// g2 = y (R1 cos a - r1) + R1 sin a (z - rho1) (eq. (14)), unknowns (alpha, rho1), from a
-/// posture whose sin and cos are given; the result carries the sin and cos of its alpha.
+/// posture whose sin and cos are given, until converged (residuals at rounding level, or
+/// Newton's last or next step below [`NEWTON_STEP_STOP`]); the best posture met when it runs
+/// out of iterations or meets a singular Jacobian. The result carries the sin and cos of its
+/// alpha.
 fn polish_leg1(g: &ModuleGeometry, p: &Vector3<f64>, start: Leg1) -> Leg1 {
-    polish_leg1_converged(g, p, start).0
-}
-
-/// [`polish_leg1`], and whether it converged (residuals at rounding level, or Newton's last or
-/// next step below [`NEWTON_STEP_STOP`]) rather than ran out of iterations or met a singular
-/// Jacobian.
-pub(crate) fn polish_leg1_converged(
-    g: &ModuleGeometry,
-    p: &Vector3<f64>,
-    start: Leg1,
-) -> (Leg1, bool) {
     let eqs = Leg1Equations::new(g, p);
     let amax = |f: [f64; 2]| f[0].abs().max(f[1].abs());
     let mut cur = start;
     let (mut f, mut dz) = eqs.residuals(&cur);
     if eqs.at_rounding(&cur, f, dz) {
-        return (with_wrapped_alpha(cur), true);
+        return with_wrapped_alpha(cur);
     }
     let mut best = (cur, amax(f));
     for _ in 0..NEWTON_MAX_ITER {
@@ -185,29 +177,37 @@ pub(crate) fn polish_leg1_converged(
         };
         cur = next;
         if settled {
-            return (with_wrapped_alpha(cur), true);
+            return with_wrapped_alpha(cur);
         }
         (f, dz) = eqs.residuals(&cur);
         if amax(f) <= best.1 {
             best = (cur, amax(f));
         }
     }
-    (with_wrapped_alpha(best.0), false)
+    with_wrapped_alpha(best.0)
 }
 
-/// One Newton step on eqs. (10) and (14) from `start` when it settles the posture (the step,
-/// or the step after it, below [`NEWTON_STEP_STOP`]: Newton has converged to rounding); else
-/// the complete [`polish_leg1_converged`] from there. None when that does not converge either.
+/// Newton on eqs. (10) and (14) from `start`, step after step, until a step settles the posture
+/// (it, or the step it predicts next, is below [`NEWTON_STEP_STOP`]: Newton has converged to
+/// rounding); None when that takes more than `max_steps` steps or the Jacobian is singular.
 #[inline]
-pub(crate) fn newton_leg1(g: &ModuleGeometry, p: &Vector3<f64>, start: Leg1) -> Option<Leg1> {
+pub(crate) fn newton_leg1(
+    g: &ModuleGeometry,
+    p: &Vector3<f64>,
+    start: Leg1,
+    max_steps: usize,
+) -> Option<Leg1> {
     let eqs = Leg1Equations::new(g, p);
-    let (f, dz) = eqs.residuals(&start);
-    let (next, settled) = eqs.newton_step(&start, f, dz)?;
-    if settled {
-        return Some(with_wrapped_alpha(next));
+    let mut cur = start;
+    for _ in 0..max_steps {
+        let (f, dz) = eqs.residuals(&cur);
+        let (next, settled) = eqs.newton_step(&cur, f, dz)?;
+        cur = next;
+        if settled {
+            return Some(with_wrapped_alpha(cur));
+        }
     }
-    let (polished, converged) = polish_leg1_converged(g, p, next);
-    converged.then_some(polished)
+    None
 }
 
 /// Eqs. (10) and (14) of leg I for one point, as g1 = u^2 + y^2 + (z - rho1)^2 - K1(alpha) and
@@ -538,22 +538,28 @@ pub(crate) fn working_on_posture(
 }
 
 /// [`crate::ik_track::certified_working`] from a start estimated without root isolation: eq.
-/// (14) to first order about alpha = 0 (sin(alpha) = -y (R1 - r1) / (R1 h), h = |z - rho1| from
-/// eq. (11) at cos(alpha) = 1), rho1 below zp by eq. (11) there. No cubic and no `acos` when
-/// Newton reaches the certified posture.
+/// (14) about alpha = 0 with z - rho1 = h(alpha) from eq. (11), h(alpha)^2 = h0^2 - 2 R1 r1
+/// (1 - cos alpha), to third order in alpha:
+///   R1 h0 a + y (R1 - r1) - y R1 a^2 / 2 - R1 (h0 / 6 + R1 r1 / (2 h0)) a^3 = 0,
+/// solved by one correction of the first-order root a1 = -y (R1 - r1) / (R1 h0). No cubic and no
+/// `acos` when Newton from there reaches the certified posture.
 fn certified_from_estimate(m: &Machine, p: &Vector3<f64>) -> Option<(IkBranch, Leg1)> {
     let g = &m.module;
     let (r, rr) = (g.r_big1, g.r_small1);
-    let h0 = leg1_height_sq(g, p, 1.0);
-    if p.y.abs() < FAST_MARGIN_MM || h0 <= 0.0 {
+    let h0_sq = leg1_height_sq(g, p, 1.0);
+    if p.y.abs() < FAST_MARGIN_MM || h0_sq <= 0.0 {
         return None;
     }
+    let inv_h0 = 1.0 / h0_sq.sqrt();
+    let a1 = -p.y * (r - rr) / r * inv_h0;
+    let cubic = h0_sq * (1.0 / 6.0) + 0.5 * r * rr;
     // Small enough for the series of sin_cos_after_step (|alpha| < 0.25).
-    let alpha = (-p.y * (r - rr) / (r * h0.sqrt())).clamp(-0.24, 0.24);
+    let alpha = (a1 + a1 * a1 * (0.5 * p.y + a1 * cubic * inv_h0) * inv_h0).clamp(-0.24, 0.24);
     let (sin, cos) = sin_cos_after_step(0.0, 1.0, alpha, -alpha);
+    // h(alpha) ~ h0 - R1 r1 (1 - cos alpha) / h0.
     let start = Leg1 {
         alpha,
-        rho1: p.z - leg1_height_sq(g, p, cos).max(1.0).sqrt(),
+        rho1: p.z - (h0_sq - r * rr * (1.0 - cos)) * inv_h0,
         sin,
         cos,
     };
