@@ -88,6 +88,12 @@ impl Verdict {
         self.0 |= r.bit();
     }
 
+    /// The reasons of both.
+    #[inline]
+    pub fn with(self, other: Verdict) -> Verdict {
+        Verdict(self.0 | other.0)
+    }
+
     pub fn has(self, r: Reason) -> bool {
         self.0 & r.bit() != 0
     }
@@ -144,26 +150,20 @@ impl LegState {
         if self.q > CONFIG_SIGN_MM { 1 } else { -1 }
     }
 
-    /// The leg's reasons (inverted, stroke, rod tilt).
+    /// The leg's reasons (inverted, stroke, rod tilt), set without branching: the reasons of
+    /// leg i are Leg1Inverted + i and Rho1Stroke + i in [`Reason`]'s order.
     #[inline]
     pub fn verdict(self) -> Verdict {
-        let mut v = Verdict::default();
-        if self.sign() != -1 {
-            v.add(
-                [
-                    Reason::Leg1Inverted,
-                    Reason::Leg2Inverted,
-                    Reason::Leg3Inverted,
-                ][self.leg],
-            );
-        }
-        if self.outside_stroke {
-            v.add([Reason::Rho1Stroke, Reason::Rho2Stroke, Reason::Rho3Stroke][self.leg]);
-        }
-        if self.tilted {
-            v.add(Reason::RodTilt);
-        }
-        v
+        let bit = |on: bool, r: u16| (on as u16) << r;
+        Verdict(
+            bit(
+                self.sign() != -1,
+                Reason::Leg1Inverted as u16 + self.leg as u16,
+            ) | bit(
+                self.outside_stroke,
+                Reason::Rho1Stroke as u16 + self.leg as u16,
+            ) | bit(self.tilted, Reason::RodTilt as u16),
+        )
     }
 
     /// Label and verdict.
@@ -194,16 +194,8 @@ pub fn leg_state(
     cos_tilt_max: f64,
 ) -> LegState {
     let g = &m.module;
-    // r.z < cos_tilt_max |r|, squared (no square root).
-    let ct2 = cos_tilt_max * cos_tilt_max;
-    let too_tilted = |r: nalgebra::Vector3<f64>| {
-        let zz = r.z * r.z;
-        if cos_tilt_max >= 0.0 {
-            r.z < 0.0 || zz < ct2 * r.norm_squared()
-        } else {
-            r.z < 0.0 && zz > ct2 * r.norm_squared()
-        }
-    };
+    let too_tilted =
+        |r: nalgebra::Vector3<f64>| rod_too_tilted(r.z, r.norm_squared(), cos_tilt_max);
     let (q, tilted) = match leg {
         0 => {
             let (dy, dz) = (g.r_big1 * c - g.r_small1, g.r_big1 * s);
@@ -229,14 +221,53 @@ pub fn leg_state(
             (rho_i - p.z - g.r_big2 * s, too_tilted(r6))
         }
     };
-    let outside_stroke =
-        rho_i < m.limits.rho_min[leg] - LIMIT_SLACK || rho_i > m.limits.rho_max[leg] + LIMIT_SLACK;
     LegState {
         leg,
         q,
         tilted,
-        outside_stroke,
+        outside_stroke: outside_stroke(m, leg, rho_i),
     }
+}
+
+/// Slider `leg` outside its stroke (with the slack of the limits).
+#[inline]
+fn outside_stroke(m: &Machine, leg: usize, rho_i: f64) -> bool {
+    rho_i < m.limits.rho_min[leg] - LIMIT_SLACK || rho_i > m.limits.rho_max[leg] + LIMIT_SLACK
+}
+
+/// A rod with z component `rz` and squared length `norm_sq` tilted beyond the passive joints'
+/// limit: r.z < cos_tilt_max |r|, squared (no square root).
+#[inline]
+fn rod_too_tilted(rz: f64, norm_sq: f64, cos_tilt_max: f64) -> bool {
+    let (zz, ct2) = (rz * rz, cos_tilt_max * cos_tilt_max);
+    if cos_tilt_max >= 0.0 {
+        rz < 0.0 || zz < ct2 * norm_sq
+    } else {
+        rz < 0.0 && zz > ct2 * norm_sq
+    }
+}
+
+/// Leg II or III (`leg` 1 or 2) at both roots of its eq. (12) or (13), rho = offset - h and
+/// offset + h, where h is the square root and (dx, dy) the rod's horizontal components: what
+/// [`leg_state`] says at each, with the rod's z component (+h, -h) and the signed quantity of
+/// s_i (-h, +h) taken from the square root instead of recomputed from rho (they agree to
+/// rounding), and the rod's length computed once for both.
+#[inline]
+pub fn outer_leg_states(
+    m: &Machine,
+    leg: usize,
+    (dx, dy, h): (f64, f64, f64),
+    rho: [f64; 2],
+    cos_tilt_max: f64,
+) -> [LegState; 2] {
+    let norm_sq = dx * dx + dy * dy + h * h;
+    let state = |q: f64, rho_i: f64| LegState {
+        leg,
+        q,
+        tilted: rod_too_tilted(-q, norm_sq, cos_tilt_max),
+        outside_stroke: outside_stroke(m, leg, rho_i),
+    };
+    [state(-h, rho[0]), state(h, rho[1])]
 }
 
 /// cos of the largest rod tilt with its slack, for [`leg_state`].
@@ -247,11 +278,14 @@ pub fn cos_tilt_max(m: &Machine) -> f64 {
 /// The reasons of a whole branch: its legs' and R1 cos(alpha) <= r1 (rods of leg I cross).
 #[inline]
 pub fn combine(m: &Machine, c: f64, legs: [Verdict; 3]) -> Verdict {
-    let mut v = Verdict(legs[0].0 | legs[1].0 | legs[2].0);
-    if m.module.r_big1 * c <= m.module.r_small1 {
-        v.add(Reason::RodsCross);
-    }
-    v
+    legs[0].with(legs[1]).with(legs[2]).with(rods_cross(m, c))
+}
+
+/// [`Reason::RodsCross`] when R1 cos(alpha) <= r1, else nothing.
+#[inline]
+pub fn rods_cross(m: &Machine, c: f64) -> Verdict {
+    let crossed = m.module.r_big1 * c <= m.module.r_small1;
+    Verdict((crossed as u16) << Reason::RodsCross as u16)
 }
 
 /// Configuration and verdict of a pose of the module with slider positions `rho`, from
@@ -300,4 +334,35 @@ pub fn module_verdict(m: &Machine, pose: &ModulePose, rho: &Sliders, config: Con
         v
     });
     combine(m, c, legs)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The branch-free [`LegState::verdict`] names each leg's own reasons.
+    #[test]
+    fn leg_verdict_names_its_own_reasons() {
+        let inverted = [
+            Reason::Leg1Inverted,
+            Reason::Leg2Inverted,
+            Reason::Leg3Inverted,
+        ];
+        let stroke = [Reason::Rho1Stroke, Reason::Rho2Stroke, Reason::Rho3Stroke];
+        for leg in 0..3 {
+            let state = |q: f64, tilted: bool, outside_stroke: bool| LegState {
+                leg,
+                q,
+                tilted,
+                outside_stroke,
+            };
+            assert!(state(-1.0, false, false).verdict().feasible());
+            let all: Vec<Reason> = state(1.0, true, true).verdict().reasons().collect();
+            assert_eq!(all, vec![inverted[leg], stroke[leg], Reason::RodTilt]);
+            let v = state(-1.0, false, true).verdict();
+            assert_eq!(v.reasons().collect::<Vec<_>>(), vec![stroke[leg]]);
+            let v = state(2.0 * CONFIG_SIGN_MM, false, false).verdict();
+            assert_eq!(v.reasons().collect::<Vec<_>>(), vec![inverted[leg]]);
+        }
+    }
 }

@@ -121,6 +121,15 @@ pub(crate) fn certified_working(
     start: Leg1,
     cos_tilt: f64,
 ) -> Option<(IkBranch, Leg1)> {
+    let leg1 = certified_posture(m, p, start)?;
+    let branch = working_on_posture(m, p, &leg1, cos_tilt).ok()??;
+    Some((branch, leg1))
+}
+
+/// The leg-I posture with s1 = -1 on the only root of the cubic (9) with R1 cos(alpha) > r1, by
+/// Newton on leg I from `start`, when that root is certified to be alone there and the posture
+/// is clear of the fast path's margins; None when unsure.
+pub(crate) fn certified_posture(m: &Machine, p: &Vector3<f64>, start: Leg1) -> Option<Leg1> {
     let g = &m.module;
     if !p.iter().all(|v| v.is_finite()) || !isolated_working_root(m, p) {
         return None;
@@ -131,11 +140,7 @@ pub(crate) fn certified_working(
     let clear = g.r_big1 * leg1.cos - g.r_small1 > FAST_MARGIN_MM
         && leg1.sin.abs() > FAST_MARGIN_RAD
         && leg1.rho1 - p.z < -FAST_MARGIN_MM;
-    if !clear {
-        return None;
-    }
-    let branch = working_on_posture(m, p, &leg1, cos_tilt).ok()??;
-    Some((branch, leg1))
+    clear.then_some(leg1)
 }
 
 /// True when the cubic (9) of `p` has at most one root with cos(alpha) in [r1/R1, 1] (slightly

@@ -7,7 +7,9 @@
 use arrayvec::ArrayVec;
 use nalgebra::Vector3;
 
-use crate::branches::{Config, Verdict, WORKING_CONFIG, combine, cos_tilt_max, leg_state};
+use crate::branches::{
+    Config, Verdict, WORKING_CONFIG, cos_tilt_max, leg_state, outer_leg_states, rods_cross,
+};
 use crate::cubic::cubic_roots_in;
 use crate::machine::{Machine, ModuleGeometry};
 use crate::module_geometry::Sliders;
@@ -81,7 +83,8 @@ fn leg1_height_sq(g: &ModuleGeometry, p: &Vector3<f64>, c: f64) -> f64 {
 
 /// Every real leg-I posture (alpha, rho1) for the point into `out`: eqs. (9), (11), (14),
 /// polished by Newton on eqs. (10) and (14) (the half-sum and half-difference of (3) and (4)).
-fn leg1_postures_into(g: &ModuleGeometry, p: &Vector3<f64>, out: &mut ArrayVec<Leg1, 6>) {
+fn leg1_postures_into(m: &Machine, p: &Vector3<f64>, out: &mut ArrayVec<Leg1, 6>) {
+    let g = &m.module;
     let (r, rr) = (g.r_big1, g.r_small1);
     out.clear();
     let Some(coeffs) = cubic_eq9(g, p) else {
@@ -95,7 +98,16 @@ fn leg1_postures_into(g: &ModuleGeometry, p: &Vector3<f64>, out: &mut ArrayVec<L
             out.push(l);
         }
     };
-    for root in cubic_roots_in(&coeffs, -1.0, 1.0) {
+    // The root with R1 cos(alpha) > r1, when it is certified alone there, by Newton on leg I
+    // from an estimate (no isolation, no acos, no separate polish); the other roots, all below
+    // r1/R1 then, by isolation.
+    let mut hi = 1.0;
+    let certified =
+        estimated_start(g, p).and_then(|start| crate::ik_track::certified_posture(m, p, start));
+    if certified.is_some() {
+        hi = rr / r - FAST_MARGIN_RAD;
+    }
+    for root in cubic_roots_in(&coeffs, -1.0, hi) {
         let c = root.x.clamp(-1.0, 1.0);
         let sin_a = ((1.0 - c) * (1.0 + c)).sqrt();
         let h2 = leg1_height_sq(g, p, c);
@@ -135,17 +147,25 @@ fn leg1_postures_into(g: &ModuleGeometry, p: &Vector3<f64>, out: &mut ArrayVec<L
                 cos: c,
             },
         );
-        // Eqs. (10) and (14) are unchanged by (alpha, z - rho1) -> (-alpha, rho1 - z): the
-        // posture at -alpha is the mirror image of this one, as exact, and needs no polish.
-        let mirror = with_wrapped_alpha(Leg1 {
-            alpha: -polished.alpha,
-            rho1: p.z + (p.z - polished.rho1),
-            sin: -polished.sin,
-            cos: polished.cos,
-        });
         push(polished);
-        push(mirror);
+        push(mirror(p, polished));
     }
+    // Last, as the root with the largest cos(alpha) (postures come out by increasing cos).
+    if let Some(leg1) = certified {
+        push(leg1);
+        push(mirror(p, leg1));
+    }
+}
+
+/// Eqs. (10) and (14) are unchanged by (alpha, z - rho1) -> (-alpha, rho1 - z): the posture at
+/// -alpha is the mirror image of `l`, as exact, and needs no polish.
+fn mirror(p: &Vector3<f64>, l: Leg1) -> Leg1 {
+    with_wrapped_alpha(Leg1 {
+        alpha: -l.alpha,
+        rho1: p.z + (p.z - l.rho1),
+        sin: -l.sin,
+        cos: l.cos,
+    })
 }
 
 /// A leg-I polish also stops when Newton's next step is predicted below this fraction of
@@ -336,14 +356,20 @@ fn angle_diff(a: f64, b: f64) -> f64 {
     wrap_angle(a - b)
 }
 
-/// Both roots of eqs. (12)-(13) for one leg: `offset + s * sqrt(L^2 - dx^2 - dy^2)`, s = -1 first.
-pub(crate) fn leg_sliders(l: f64, dx: f64, dy: f64, offset: f64) -> Option<[f64; 2]> {
+/// The square root of eqs. (12)-(13) for one leg, sqrt(L^2 - dx^2 - dy^2); None when the leg
+/// cannot reach (the argument below zero beyond rounding).
+#[inline]
+pub(crate) fn leg_root(l: f64, dx: f64, dy: f64) -> Option<f64> {
     let arg = l * l - dx * dx - dy * dy;
     if arg < -SQRT_ARG_REL * l * l || !arg.is_finite() {
         return None;
     }
-    let h = arg.max(0.0).sqrt();
-    Some([offset - h, offset + h])
+    Some(arg.max(0.0).sqrt())
+}
+
+/// Both roots of eqs. (12)-(13) for one leg: `offset + s * sqrt(L^2 - dx^2 - dy^2)`, s = -1 first.
+pub(crate) fn leg_sliders(l: f64, dx: f64, dy: f64, offset: f64) -> Option<[f64; 2]> {
+    leg_root(l, dx, dy).map(|h| [offset - h, offset + h])
 }
 
 /// Every real inverse-kinematics branch of the parallel module for point `p`, ordered by alpha
@@ -365,7 +391,7 @@ pub fn solve_into(m: &Machine, p: &Vector3<f64>, out: &mut IkBranches) {
     // Branches come out ordered by alpha, then (s1, s2, s3): postures sorted by (alpha, s1), and
     // within a posture s2, s3 = -1 before +1 (the roots of (12)-(13) in increasing order).
     let mut legs1 = ArrayVec::<Leg1, 6>::new();
-    leg1_postures_into(g, p, &mut legs1);
+    leg1_postures_into(m, p, &mut legs1);
     let n = legs1.len();
     let mut checks = [(0i8, Verdict::default()); 6];
     for (k, l) in legs1.iter().enumerate() {
@@ -397,26 +423,29 @@ pub fn solve_into(m: &Machine, p: &Vector3<f64>, out: &mut IkBranches) {
         let (s, c) = (leg1.sin, leg1.cos);
         let dx2 = p.x + g.dx2;
         // eq. (12): rho2 = zp - R2 sin a + s2 sqrt(L2^2 - (xp + D2 - d2)^2 - (yp - R2 cos a + r4)^2)
-        let Some(r2) = leg_sliders(g.l2, dx2, p.y - g.r_big2 * c + g.r4, p.z - g.r_big2 * s) else {
+        let (dy2, off2) = (p.y - g.r_big2 * c + g.r4, p.z - g.r_big2 * s);
+        let Some(h2) = leg_root(g.l2, dx2, dy2) else {
             continue;
         };
         // eq. (13): rho3 = zp + R2 sin a + s3 sqrt(L3^2 - (xp + D2 - d2)^2 - (yp + R2 cos a - r4)^2)
-        let Some(r3) = leg_sliders(g.l3, dx2, p.y + g.r_big2 * c - g.r4, p.z + g.r_big2 * s) else {
+        let (dy3, off3) = (p.y + g.r_big2 * c - g.r4, p.z + g.r_big2 * s);
+        let Some(h3) = leg_root(g.l3, dx2, dy3) else {
             continue;
         };
-        // Labels and verdicts leg by leg: leg I once per posture, legs II and III once per root.
-        let leg = |i: usize, rho_i: f64| leg_state(m, i, p, s, c, rho_i, cos_tilt).check();
-        let l2 = [leg(1, r2[0]), leg(1, r2[1])];
-        let l3 = [leg(2, r3[0]), leg(2, r3[1])];
-        let four: [IkBranch; 4] = std::array::from_fn(|k| {
-            let (k2, k3) = (k / 2, k % 2);
-            IkBranch {
-                alpha: leg1.alpha,
-                rho: Sliders::new(leg1.rho1, r2[k2], r3[k3]),
-                config: [l1.0, l2[k2].0, l3[k3].0],
-                verdict: combine(m, c, [l1.1, l2[k2].1, l3[k3].1]),
-            }
-        });
+        let (r2, r3) = ([off2 - h2, off2 + h2], [off3 - h3, off3 + h3]);
+        // Labels and verdicts leg by leg: leg I once per posture, legs II and III once per pair
+        // of roots.
+        let [l2a, l2b] = outer_leg_states(m, 1, (dx2, dy2, h2), r2, cos_tilt);
+        let [l3a, l3b] = outer_leg_states(m, 2, (dx2, dy3, h3), r3, cos_tilt);
+        let (l2, l3) = ([l2a.check(), l2b.check()], [l3a.check(), l3b.check()]);
+        let v1 = l1.1.with(rods_cross(m, c));
+        let branch = |k2: usize, k3: usize| IkBranch {
+            alpha: leg1.alpha,
+            rho: Sliders::new(leg1.rho1, r2[k2], r3[k3]),
+            config: [l1.0, l2[k2].0, l3[k3].0],
+            verdict: v1.with(l2[k2].1).with(l3[k3].1),
+        };
+        let four = [branch(0, 0), branch(0, 1), branch(1, 0), branch(1, 1)];
         let pushed = out.try_extend_from_slice(&four);
         debug_assert!(
             pushed.is_ok(),
@@ -512,22 +541,29 @@ pub(crate) fn working_on_posture(
     let g = &m.module;
     let (s, c) = (leg1.sin, leg1.cos);
     let dx2 = p.x + g.dx2;
-    let lower = |l: f64, dy: f64, offset: f64| match leg_sliders(l, dx2, dy, offset) {
-        Some([lo, hi]) if hi - lo > 2.0 * FAST_MARGIN_MM => Ok(Some(lo)),
+    // The lower root of (12) or (13) (s = -1) and its leg's state, as [`solve`] has them.
+    let lower = |leg: usize, l: f64, dy: f64, offset: f64| match leg_root(l, dx2, dy) {
+        Some(h) if h > FAST_MARGIN_MM => {
+            let rho = [offset - h, offset + h];
+            Ok(Some((
+                rho[0],
+                outer_leg_states(m, leg, (dx2, dy, h), rho, cos_tilt)[0],
+            )))
+        }
         Some(_) => Err(()),
         None if l * l - dx2 * dx2 - dy * dy > -FAST_MARGIN_MM * l => Err(()),
         None => Ok(None),
     };
-    let r2 = lower(g.l2, p.y - g.r_big2 * c + g.r4, p.z - g.r_big2 * s)?;
-    let r3 = lower(g.l3, p.y + g.r_big2 * c - g.r4, p.z + g.r_big2 * s)?;
-    let (Some(rho2), Some(rho3)) = (r2, r3) else {
+    let r2 = lower(1, g.l2, p.y - g.r_big2 * c + g.r4, p.z - g.r_big2 * s)?;
+    let r3 = lower(2, g.l3, p.y + g.r_big2 * c - g.r4, p.z + g.r_big2 * s)?;
+    let (Some((rho2, leg2)), Some((rho3, leg3))) = (r2, r3) else {
         return Ok(None);
     };
     // Feasible: every leg as on the machine and inside its limits, rods of leg I not crossing
     // (what [`combine`] of the three legs' verdicts says, without building it).
     let feasible = leg_state(m, 0, p, s, c, leg1.rho1, cos_tilt).ok()
-        && leg_state(m, 1, p, s, c, rho2, cos_tilt).ok()
-        && leg_state(m, 2, p, s, c, rho3, cos_tilt).ok()
+        && leg2.ok()
+        && leg3.ok()
         && g.r_big1 * c > g.r_small1;
     Ok(feasible.then_some(IkBranch {
         alpha: leg1.alpha,
@@ -537,14 +573,14 @@ pub(crate) fn working_on_posture(
     }))
 }
 
-/// [`crate::ik_track::certified_working`] from a start estimated without root isolation: eq.
-/// (14) about alpha = 0 with z - rho1 = h(alpha) from eq. (11), h(alpha)^2 = h0^2 - 2 R1 r1
-/// (1 - cos alpha), to third order in alpha:
+/// A leg-I start near the posture with s1 = -1 on the root of (9) nearest cos(alpha) = 1,
+/// estimated without root isolation: eq. (14) about alpha = 0 with z - rho1 = h(alpha) from eq.
+/// (11), h(alpha)^2 = h0^2 - 2 R1 r1 (1 - cos alpha), to third order in alpha:
 ///   R1 h0 a + y (R1 - r1) - y R1 a^2 / 2 - R1 (h0 / 6 + R1 r1 / (2 h0)) a^3 = 0,
-/// solved by one correction of the first-order root a1 = -y (R1 - r1) / (R1 h0). No cubic and no
-/// `acos` when Newton from there reaches the certified posture.
-fn certified_from_estimate(m: &Machine, p: &Vector3<f64>) -> Option<(IkBranch, Leg1)> {
-    let g = &m.module;
+/// solved by one correction of the first-order root a1 = -y (R1 - r1) / (R1 h0). None where
+/// y is near 0 (alpha = 0 is then a root and both its postures meet) or leg I cannot reach at
+/// alpha = 0.
+fn estimated_start(g: &ModuleGeometry, p: &Vector3<f64>) -> Option<Leg1> {
     let (r, rr) = (g.r_big1, g.r_small1);
     let h0_sq = leg1_height_sq(g, p, 1.0);
     if p.y.abs() < FAST_MARGIN_MM || h0_sq <= 0.0 {
@@ -557,12 +593,18 @@ fn certified_from_estimate(m: &Machine, p: &Vector3<f64>) -> Option<(IkBranch, L
     let alpha = (a1 + a1 * a1 * (0.5 * p.y + a1 * cubic * inv_h0) * inv_h0).clamp(-0.24, 0.24);
     let (sin, cos) = sin_cos_after_step(0.0, 1.0, alpha, -alpha);
     // h(alpha) ~ h0 - R1 r1 (1 - cos alpha) / h0.
-    let start = Leg1 {
+    Some(Leg1 {
         alpha,
         rho1: p.z - (h0_sq - r * rr * (1.0 - cos)) * inv_h0,
         sin,
         cos,
-    };
+    })
+}
+
+/// [`crate::ik_track::certified_working`] from [`estimated_start`]: no cubic and no `acos` when
+/// Newton reaches the certified posture.
+fn certified_from_estimate(m: &Machine, p: &Vector3<f64>) -> Option<(IkBranch, Leg1)> {
+    let start = estimated_start(&m.module, p)?;
     crate::ik_track::certified_working(m, p, start, cos_tilt_max(m))
 }
 
