@@ -124,6 +124,47 @@ fn bracketed(c: &[f64; 4], mut a: f64, mut b: f64, fa: f64, fb: f64) -> Root {
     Root { x, touching: false }
 }
 
+/// How far (relative to the quadratic's largest coefficient, squared) the discriminant of a
+/// deflated cubic, and (absolute) its roots from the interval's ends, must be for
+/// [`deflated_roots_in`] to decide alone.
+const DEFLATED_DISC_MARGIN: f64 = 1e-6;
+const DEFLATED_END_MARGIN: f64 = 1e-9;
+
+/// The roots in (lo, hi) of `c[0] + c[1] x + c[2] x^2 + c[3] x^3` other than its known root `w`
+/// (outside [lo, hi]): the quadratic c / (x - w) in closed form, sorted. None when that is a close
+/// call (a discriminant near zero: a close pair or double root; a root near `lo` or `hi`), so
+/// that [`cubic_roots_in`] decides; a caller polishes the roots on its own equations (the
+/// deflation adds a rounding error of the order of `w`'s).
+pub fn deflated_roots_in(c: &[f64; 4], w: f64, lo: f64, hi: f64) -> Option<ArrayVec<f64, 2>> {
+    // Synthetic division: c = (x - w) (a x^2 + b x + k) + remainder.
+    let a = c[3];
+    let b = c[2] + w * a;
+    let k = c[1] + w * b;
+    let scale = a.abs().max(b.abs()).max(k.abs());
+    if a.abs() <= 1e-8 * scale || !scale.is_finite() {
+        return None;
+    }
+    let disc = b * b - 4.0 * a * k;
+    let mut out = ArrayVec::new();
+    if disc.abs() <= DEFLATED_DISC_MARGIN * scale * scale {
+        return None;
+    }
+    if disc < 0.0 {
+        return Some(out);
+    }
+    let q = -0.5 * (b + b.signum() * disc.sqrt());
+    let (x1, x2) = (q / a, k / q);
+    for x in if x1 <= x2 { [x1, x2] } else { [x2, x1] } {
+        if (x - lo).abs() <= DEFLATED_END_MARGIN || (x - hi).abs() <= DEFLATED_END_MARGIN {
+            return None;
+        }
+        if x > lo && x < hi {
+            out.push(x);
+        }
+    }
+    Some(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -182,5 +223,41 @@ mod tests {
         let got = cubic_roots_in(&from_roots([-1.0, 2.0, 0.25], 1.0), -1.0, 1.0);
         assert_eq!(got.len(), 2, "{got:?}");
         assert_eq!(got[0].x, -1.0);
+    }
+
+    /// The deflated roots are the isolator's, to rounding, whenever they decide.
+    #[test]
+    fn deflation_agrees_with_isolation() {
+        let mut s = 7u64;
+        let mut unit = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut decided = 0;
+        for _ in 0..20_000 {
+            let w = 0.5 + 0.5 * unit();
+            let (r2, r3) = (2.4 * unit() - 1.2, 2.4 * unit() - 1.2);
+            let c = from_roots([w, r2, r3], 0.3 + unit());
+            let hi = 0.45;
+            let Some(fast) = deflated_roots_in(&c, w, -1.0, hi) else {
+                continue;
+            };
+            decided += 1;
+            let slow = cubic_roots_in(&c, -1.0, hi);
+            assert_eq!(
+                fast.len(),
+                slow.len(),
+                "{w} {r2} {r3}: {fast:?} vs {slow:?}"
+            );
+            for (f, g) in fast.iter().zip(&slow) {
+                assert!(
+                    (f - g.x).abs() < 1e-9,
+                    "{w} {r2} {r3}: {fast:?} vs {slow:?}"
+                );
+            }
+        }
+        assert!(decided > 19_000, "{decided}");
     }
 }

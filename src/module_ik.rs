@@ -10,7 +10,7 @@ use nalgebra::Vector3;
 use crate::branches::{
     Config, Verdict, WORKING_CONFIG, cos_tilt_max, leg_state, outer_leg_states, rods_cross,
 };
-use crate::cubic::cubic_roots_in;
+use crate::cubic::{cubic_roots_in, deflated_roots_in};
 use crate::machine::{Machine, ModuleGeometry};
 use crate::module_geometry::Sliders;
 use crate::tolerance::{
@@ -101,14 +101,27 @@ fn leg1_postures_into(m: &Machine, p: &Vector3<f64>, out: &mut ArrayVec<Leg1, 6>
     // The root with R1 cos(alpha) > r1, when it is certified alone there, by Newton on leg I
     // from an estimate (no isolation, no acos, no separate polish); the other roots, all below
     // r1/R1 then, by isolation.
-    let mut hi = 1.0;
     let certified =
         estimated_start(g, p).and_then(|start| crate::ik_track::certified_posture(m, p, start));
-    if certified.is_some() {
-        hi = rr / r - FAST_MARGIN_RAD;
-    }
-    for root in cubic_roots_in(&coeffs, -1.0, hi) {
-        let c = root.x.clamp(-1.0, 1.0);
+    let roots: ArrayVec<f64, 8> = match certified {
+        // Below r1/R1: the cubic divided by the known root, unless that is a close call.
+        Some(leg1) => {
+            let hi = rr / r - FAST_MARGIN_RAD;
+            match deflated_roots_in(&coeffs, leg1.cos, -1.0, hi) {
+                Some(roots) => roots.into_iter().collect(),
+                None => cubic_roots_in(&coeffs, -1.0, hi)
+                    .iter()
+                    .map(|t| t.x)
+                    .collect(),
+            }
+        }
+        None => cubic_roots_in(&coeffs, -1.0, 1.0)
+            .iter()
+            .map(|t| t.x)
+            .collect(),
+    };
+    for root in roots {
+        let c = root.clamp(-1.0, 1.0);
         let sin_a = ((1.0 - c) * (1.0 + c)).sqrt();
         let h2 = leg1_height_sq(g, p, c);
         let h = if h2 >= -SQRT_ARG_REL * g.l1 * g.l1 {
