@@ -422,7 +422,7 @@ impl Isolation {
 
     /// sin and cos of x along a Newton iteration: from those of the previous point when it is
     /// close ([`sin_cos_after_step`]), kept in `last`.
-    #[inline]
+    #[inline(always)]
     fn sin_cos_following(x: f64, last: &std::cell::Cell<Option<(f64, f64, f64)>>) -> (f64, f64) {
         let (s1, c1) = match last.get() {
             Some((x0, s0, c0)) => sin_cos_after_step(s0, c0, x, x0 - x),
@@ -440,7 +440,7 @@ impl Isolation {
     }
 
     /// g and h (two of F, F', F'') at x along a Newton iteration, without the third.
-    #[inline]
+    #[inline(always)]
     fn pair_following(
         x: f64,
         last: &std::cell::Cell<Option<(f64, f64, f64)>>,
@@ -493,7 +493,16 @@ impl Isolation {
         }
         if same_sign_beyond(a.s, b.s, w * self.m4 + self.es) {
             if opposite_beyond(a.d, b.d, self.ed) {
-                let c = self.critical(a, b);
+                // F is convex or concave here: a point where F is beyond rounding on the other
+                // side of zero from both ends splits [a, b] into two pieces with one simple root
+                // each. The estimate of the critical point usually is one (two close assembly
+                // modes); otherwise the critical point itself decides.
+                let guess = hermite_start(a.x, b.x, a.d, b.d, a.s, b.s);
+                let (sg, cg) = sin_cos_after_step(a.sin, a.cos, guess, a.x - guess);
+                let g = self.at_sc(guess, sg, cg);
+                let splits =
+                    opposite_beyond(g.f, a.f, self.ef) && opposite_beyond(g.f, b.f, self.ef);
+                let c = if splits { g } else { self.critical(a, b) };
                 if c.f.abs() <= self.ef {
                     return None;
                 }
@@ -544,7 +553,8 @@ impl Isolation {
         }
     }
 
-    /// F monotone on [a.x, b.x]: its root there when F changes sign beyond rounding.
+    /// F monotone on [a.x, b.x], or convex or concave there with one simple root: its root there
+    /// when F changes sign beyond rounding.
     fn monotone(&mut self, a: Pt, b: Pt) {
         if opposite_beyond(a.f, b.f, self.ef) {
             let start = root_start(a, b);
