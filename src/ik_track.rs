@@ -152,7 +152,10 @@ pub(crate) fn isolated_working_root(m: &Machine, p: &Vector3<f64>) -> bool {
     // The coefficients of (9) as cubic_eq9 has them, without its normalisation (no division):
     // the margin is taken relative to the largest.
     let [c0, c1, c2, c3] = eq9_coefficients(g, p);
-    let margin = MONOTONE_MARGIN * c0.abs().max(c1.abs()).max(c2.abs()).max(c3.abs());
+    // Plain comparisons (no NaN handling of f64::max): a NaN coefficient fails every test below.
+    let larger = |a: f64, b: f64| if a > b { a } else { b };
+    let largest = larger(larger(c0.abs(), c1.abs()), larger(c2.abs(), c3.abs()));
+    let margin = MONOTONE_MARGIN * largest;
     let leading_positive = c3 > margin;
     if !leading_positive || !margin.is_finite() {
         return false;
