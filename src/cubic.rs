@@ -169,6 +169,17 @@ pub fn deflated_roots_in(c: &[f64; 4], w: f64, lo: f64, hi: f64) -> Option<Array
 mod tests {
     use super::*;
 
+    /// Uniform numbers in [0, 1) from a fixed seed (a 64-bit LCG).
+    fn lcg(seed: u64) -> impl FnMut() -> f64 {
+        let mut s = seed;
+        move || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
     fn from_roots(rs: [f64; 3], lead: f64) -> [f64; 4] {
         let [r1, r2, r3] = rs;
         [
@@ -182,13 +193,7 @@ mod tests {
     /// Same roots as the general routine, to rounding, on random cubics and sub-intervals.
     #[test]
     fn agrees_with_the_general_routine() {
-        let mut s = 1u64;
-        let mut unit = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut unit = lcg(1);
         for _ in 0..20_000 {
             let rs = [2.4 * unit() - 1.2, 2.4 * unit() - 1.2, 2.4 * unit() - 1.2];
             let c = from_roots(rs, if unit() < 0.5 { -1.0 } else { 0.3 });
@@ -228,13 +233,7 @@ mod tests {
     /// The deflated roots are the isolator's, to rounding, whenever they decide.
     #[test]
     fn deflation_agrees_with_isolation() {
-        let mut s = 7u64;
-        let mut unit = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut unit = lcg(7);
         let mut decided = 0;
         for _ in 0..20_000 {
             let w = 0.5 + 0.5 * unit();

@@ -100,7 +100,7 @@ fn leg1_postures_into(m: &Machine, p: &Vector3<f64>, out: &mut ArrayVec<Leg1, 6>
     };
     // The root with R1 cos(alpha) > r1, when it is certified alone there, by Newton on leg I
     // from an estimate (no isolation, no acos, no separate polish); the other roots, all below
-    // r1/R1 then, by isolation.
+    // r1/R1 then, from the cubic divided by it, or by isolation when that is a close call.
     let certified =
         estimated_start(g, p).and_then(|start| crate::ik_track::certified_posture(m, p, start));
     let roots: ArrayVec<f64, 8> = match certified {
