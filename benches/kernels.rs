@@ -26,7 +26,7 @@ use std::f64::consts::TAU;
 use std::fmt::Write as _;
 use std::hint::black_box;
 use std::io::Cursor;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use criterion::{Criterion, Throughput};
@@ -34,7 +34,6 @@ use nalgebra::{Matrix4, Vector3, Vector4};
 use verne::branches::{Config, config_of, module_verdict};
 use verne::cubic::cubic_roots_in;
 use verne::fk_track::FkTracker;
-use verne::ik_track::IkTracker;
 use verne::machine::{Machine, ModuleGeometry};
 use verne::machine_kin::{FirstRowChoice, PathState, machine_fk, path_candidates};
 use verne::module_fk::{self, FkModes};
@@ -355,6 +354,8 @@ struct Fixture {
     verify_options: VerifyOptions,
     /// Workspace kernels: options and the grid layer, per `Of::Platform` and `Of::Tool`.
     ws: Vec<(WorkspaceOptions, Vec<Vector3<f64>>)>,
+    /// The IK lists of one run of rows, reused (as the streaming engine keeps its own).
+    ik_slots: Mutex<Vec<module_ik::IkBranches>>,
 }
 
 impl Fixture {
@@ -478,6 +479,7 @@ impl Fixture {
             verify_joints_csv: joints_csv.into_bytes().into(),
             verify_options,
             ws,
+            ik_slots: Mutex::new(vec![module_ik::IkBranches::new(); RUN_ROWS]),
         };
         fx.check_fused_system();
         fx
@@ -596,25 +598,24 @@ impl Fixture {
         (tracked, solved)
     }
 
-    /// The IK working branch along `pts` in runs of RUN_ROWS with [`IkTracker`] (as `verne ik`
-    /// does); `each` sees every row's answer.
-    fn run_ik_tracker(
+    /// The IK working branch of every point of `pts`, each alone, in runs of RUN_ROWS through
+    /// `module_ik::solve_working_each` (as `verne ik` does: LANES points side by side, into
+    /// lists reused from run to run); `each` sees every row's answer. Returns (rows,
+    /// rows `module_ik::working_lanes` answered).
+    fn run_ik_lanes(
         &self,
         pts: &[Vector3<f64>],
         mut each: impl FnMut(&Vector3<f64>, &module_ik::IkBranches),
-    ) -> (u64, u64) {
-        let mut b = module_ik::IkBranches::new();
-        let (mut tracked, mut solved) = (0, 0);
+    ) -> usize {
+        let mut slots = self.ik_slots.lock().expect("one benchmark at a time");
         for run in pts.chunks(RUN_ROWS) {
-            let mut t = IkTracker::new(&self.machine);
-            for p in run {
-                t.working_into(black_box(p), &mut b);
-                each(p, &b);
+            let rows = run.iter().map(|p| *black_box(p)).zip(slots.iter_mut());
+            module_ik::solve_working_each(&self.machine, rows);
+            for (p, b) in run.iter().zip(slots.iter()) {
+                each(p, b);
             }
-            tracked += t.tracked;
-            solved += t.solved;
         }
-        (tracked, solved)
+        pts.len()
     }
 
     /// Every branch of every tool pose of the machine path, over both orientation solutions of
@@ -723,7 +724,7 @@ impl Fixture {
             ("scattered (no continuity)", &self.scatter),
         ] {
             let (mut dr, mut da, mut mismatch) = (0.0f64, 0.0f64, 0usize);
-            let (tracked, solved) = self.run_ik_tracker(pts, |p, got| {
+            self.run_ik_lanes(pts, |p, got| {
                 let full = module_ik::solve(&self.machine, p);
                 match (module_ik::working(got), module_ik::working(&full)) {
                     (Some(a), Some(b)) => {
@@ -737,11 +738,23 @@ impl Fixture {
                     _ => mismatch += 1,
                 }
             });
+            let by_lanes: usize = pts
+                .chunks_exact(module_ik::LANES)
+                .map(|c| {
+                    let c: &[Vector3<f64>; module_ik::LANES] = c.try_into().unwrap();
+                    module_ik::working_lanes(&self.machine, c)
+                        .iter()
+                        .flatten()
+                        .count()
+                })
+                .sum();
             lines.push(format!(
-                "ik_track::IkTracker on {label}: {} rows in runs of {RUN_ROWS}, {tracked} tracked, \
-                 {solved} by module_ik::solve_working_into; vs module_ik::working(module_ik::solve): \
+                "module_ik::solve_working_each on {label}: {} rows, {by_lanes} answered by \
+                 module_ik::working_lanes ({} side by side), the others by \
+                 module_ik::solve_working_into; vs module_ik::working(module_ik::solve): \
                  max |d rho| {dr:.1e} mm, max |d alpha| {da:.1e} rad, {mismatch} mismatched rows",
                 pts.len(),
+                module_ik::LANES,
             ));
         }
         let (_, it_fk) = self.run_newton_fk();
@@ -907,10 +920,10 @@ const KERNELS: &[(&str, &str, &str, &str)] = &[
         "< 100 ns/pose and <= 0.5x Newton IK (each point alone)",
     ),
     (
-        "ik/working_track",
+        "ik/working_lanes",
         "module pose",
         "ik/newton_warm",
-        "< 100 ns/pose and <= 0.5x Newton IK (along the path, as `verne ik`)",
+        "< 100 ns/pose and <= 0.5x Newton IK (each point alone, four side by side, as `verne ik`)",
     ),
     (
         "ik/all_branches",
@@ -1065,9 +1078,9 @@ fn main() {
     bench(&mut c, &rec, "ik", "working_branch_scattered", n, || {
         fx.run_ik_working(&fx.scatter)
     });
-    bench(&mut c, &rec, "ik", "working_track", n, || {
+    bench(&mut c, &rec, "ik", "working_lanes", n, || {
         let mut acc = 0.0;
-        fx.run_ik_tracker(&fx.path, |_, b| {
+        fx.run_ik_lanes(&fx.path, |_, b| {
             if let Some(w) = module_ik::working(b) {
                 acc += w.rho.x;
             }

@@ -11,7 +11,6 @@ pub mod error;
 pub mod fk_track;
 pub mod fuzz_entry;
 pub mod glider;
-pub mod ik_track;
 pub mod jacobian;
 pub mod machine;
 pub mod machine_kin;

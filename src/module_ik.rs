@@ -16,7 +16,7 @@ use crate::module_geometry::Sliders;
 use crate::tolerance::{
     NEWTON_MAX_ITER, NEWTON_STEP_STOP, SAME_SOLUTION_RAD, SIN_ALPHA_ZERO, SQRT_ARG_REL,
 };
-use crate::trig::sin_cos_after_step;
+use crate::trig::{SMALL_ANGLE, sin_cos_after_step, sin_cos_small};
 
 /// Most branches one point can have: three roots of eq. (9), two alphas each, two rho2, two rho3.
 pub const MAX_IK_BRANCHES: usize = 24;
@@ -98,11 +98,13 @@ fn leg1_postures_into(m: &Machine, p: &Vector3<f64>, out: &mut ArrayVec<Leg1, 6>
             out.push(l);
         }
     };
-    // The root with R1 cos(alpha) > r1, when it is certified alone there, by Newton on leg I
+    // The root with R1 cos(alpha) > r1, when it is certified alone there, by Chebyshev on leg I
     // from an estimate (no isolation, no acos, no separate polish); the other roots, all below
     // r1/R1 then, from the cubic divided by it, or by isolation when that is a close call.
-    let certified =
-        estimated_start(g, p).and_then(|start| crate::ik_track::certified_posture(m, p, start));
+    let certified = match estimated_start(g, p) {
+        (start, true) => certified_posture(m, p, start),
+        _ => None,
+    };
     let roots: ArrayVec<f64, 8> = match certified {
         // Below r1/R1: the cubic divided by the known root, unless that is a close call.
         Some(leg1) => {
@@ -220,9 +222,10 @@ fn polish_leg1(g: &ModuleGeometry, p: &Vector3<f64>, start: Leg1) -> Leg1 {
     with_wrapped_alpha(best.0)
 }
 
-/// Newton on eqs. (10) and (14) from `start`, step after step, until a step settles the posture
-/// (it, or the step it predicts next, is below [`NEWTON_STEP_STOP`]: Newton has converged to
-/// rounding); None when that takes more than `max_steps` steps or the Jacobian is singular.
+/// Chebyshev's method on eqs. (10) and (14) from `start` ([`Leg1Equations::corrected_step`]),
+/// step after step, until a step settles the posture (it, or the error it predicts is left, is
+/// below [`NEWTON_STEP_STOP`]: converged to rounding); None when that takes more than
+/// `max_steps` steps, or a step is singular or too long for the sin/cos series.
 #[inline]
 pub(crate) fn newton_leg1(
     g: &ModuleGeometry,
@@ -233,14 +236,27 @@ pub(crate) fn newton_leg1(
     let eqs = Leg1Equations::new(g, p);
     let mut cur = start;
     for _ in 0..max_steps {
-        let (f, dz) = eqs.residuals(&cur);
-        let (next, settled) = eqs.newton_step(&cur, f, dz)?;
-        cur = next;
-        if settled {
+        let step = eqs.corrected_step(&cur);
+        if !step.usable {
+            return None;
+        }
+        cur = step.leg1;
+        if step.settled {
             return Some(with_wrapped_alpha(cur));
         }
     }
     None
+}
+
+/// One step of [`Leg1Equations::corrected_step`].
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Leg1Step {
+    pub leg1: Leg1,
+    /// Converged to rounding (see [`Leg1Equations::corrected_step`]).
+    pub settled: bool,
+    /// False when the Jacobian was singular, the step not finite, or longer than the series
+    /// of sin and cos allow ([`SMALL_ANGLE`]): `leg1` is then meaningless.
+    pub usable: bool,
 }
 
 /// Eqs. (10) and (14) of leg I for one point, as g1 = u^2 + y^2 + (z - rho1)^2 - K1(alpha) and
@@ -338,6 +354,69 @@ impl Leg1Equations {
         let settled = next_alpha <= PREDICTED_STEP_FRACTION * NEWTON_STEP_STOP * det.abs()
             && next_rho1 <= PREDICTED_STEP_FRACTION * rho_stop * det.abs();
         Some((next, settled))
+    }
+}
+
+impl Leg1Equations {
+    /// Chebyshev's step from `cur`: Newton's step d = J^-1 g corrected by the curvature of
+    /// (g1, g2), J^-1 (g + H[d, d] / 2) (H: their second derivatives), third order where
+    /// Newton is second; without a branch, so that [`working_lanes`] can run points side by side.
+    /// Settled when the step, or the error it predicts is left, is below [`NEWTON_STEP_STOP`]
+    /// (the latter by a factor [`PREDICTED_STEP_FRACTION`]: the rounding of the result).
+    #[inline(always)]
+    pub(crate) fn corrected_step(&self, cur: &Leg1) -> Leg1Step {
+        let (r, rr, y) = (self.r, self.rr, self.y);
+        let (f, dz) = self.residuals(cur);
+        let (s, c) = (cur.sin, cur.cos);
+        // Jacobian of (g1, g2) in (alpha, rho1), solved by Cramer's rule.
+        let (j11, j12, j21, j22) = (2.0 * r * rr * s, -2.0 * dz, -y * r * s + r * c * dz, -r * s);
+        let det = j11 * j22 - j12 * j21;
+        let inv = 1.0 / det;
+        let solve = |b: [f64; 2]| {
+            [
+                (j22 * b[0] - j12 * b[1]) * inv,
+                (j11 * b[1] - j21 * b[0]) * inv,
+            ]
+        };
+        let d = solve(f);
+        // Second derivatives: g1_aa = 2 R1 r1 cos a, g1_rr = 2; g2_aa = -y R1 cos a - R1 sin a
+        // (z - rho1), g2_ar = -R1 cos a.
+        let g2_aa = -y * r * c - r * s * dz;
+        let step = solve([
+            f[0] + r * rr * c * d[0] * d[0] + d[1] * d[1],
+            f[1] + 0.5 * g2_aa * d[0] * d[0] - r * c * d[0] * d[1],
+        ]);
+        let (sd, cd) = sin_cos_small(step[0]);
+        let leg1 = Leg1 {
+            alpha: cur.alpha - step[0],
+            rho1: cur.rho1 - step[1],
+            sin: s * cd - c * sd,
+            cos: c * cd + s * sd,
+        };
+        let usable = step[0].abs() < SMALL_ANGLE && step[1].is_finite();
+        let rho_stop = NEWTON_STEP_STOP * (1.0 + leg1.rho1.abs());
+        // What is left is J^-1 (H[d, k] - T[d, d, d] / 6), k = step - d the correction, T the
+        // third derivatives (g1_aaa = -2 R1 r1 sin a; g2_aaa = y R1 sin a - R1 cos a (z - rho1),
+        // g2_aar = R1 sin a), bounded term by term.
+        let (da, dr) = (d[0].abs(), d[1].abs());
+        let (ka, kr) = ((step[0] - d[0]).abs(), (step[1] - d[1]).abs());
+        let da3 = da * da * da;
+        let left1 =
+            2.0 * (r * rr * c).abs() * da * ka + 2.0 * dr * kr + (r * rr * s).abs() * da3 / 3.0;
+        let left2 = g2_aa.abs() * da * ka
+            + (r * c).abs() * (da * kr + dr * ka)
+            + ((y * r * s).abs() + (r * c * dz).abs()) * da3 / 6.0
+            + 0.5 * (r * s).abs() * da * da * dr;
+        let left_alpha = (j22.abs() * left1 + j12.abs() * left2) * inv.abs();
+        let left_rho1 = (j21.abs() * left1 + j11.abs() * left2) * inv.abs();
+        let small_step = (step[0].abs() < NEWTON_STEP_STOP) & (step[1].abs() < rho_stop);
+        let small_left = (left_alpha <= PREDICTED_STEP_FRACTION * NEWTON_STEP_STOP)
+            & (left_rho1 <= PREDICTED_STEP_FRACTION * rho_stop);
+        Leg1Step {
+            leg1,
+            settled: small_step | small_left,
+            usable,
+        }
     }
 }
 
@@ -484,9 +563,10 @@ pub fn working_fast(m: &Machine, p: &Vector3<f64>) -> Option<IkBranch> {
     if !p.iter().all(|v| v.is_finite()) {
         return None;
     }
-    if let Some((branch, _)) = certified_from_estimate(m, p) {
+    if let [Some(branch)] = working_lanes(m, &[*p]) {
         return Some(branch);
     }
+    // Not sure: the roots of the cubic above r1/R1, each polished.
     let coeffs = cubic_eq9(g, p)?;
     let (r, rr) = (g.r_big1, g.r_small1);
     let lo = (rr / r - FAST_MARGIN_RAD).max(-1.0);
@@ -551,74 +631,171 @@ pub(crate) fn working_on_posture(
     leg1: &Leg1,
     cos_tilt: f64,
 ) -> Result<Option<IkBranch>, ()> {
+    let lower = lower_branch(m, p, leg1, cos_tilt);
+    if lower.close_call {
+        return Err(());
+    }
+    Ok(lower.feasible.then_some(lower.branch))
+}
+
+/// What [`lower_branch`] finds.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct LowerBranch {
+    /// The branch s = (-1, -1, -1), labelled as working (only meaningful when `feasible`).
+    pub branch: IkBranch,
+    /// Legs II and III reach; every leg as on the machine and inside its limits; rods of leg I
+    /// not crossing (what [`crate::branches::combine`] of the legs' verdicts says, without
+    /// building it).
+    pub feasible: bool,
+    /// A square root of (12)-(13) within [`FAST_MARGIN_MM`] of zero.
+    pub close_call: bool,
+}
+
+/// The branch on a leg-I posture with the lower roots of eqs. (12)-(13), each leg's state as
+/// [`solve`] has it, without a branch (for [`working_lanes`]).
+#[inline(always)]
+pub(crate) fn lower_branch(
+    m: &Machine,
+    p: &Vector3<f64>,
+    leg1: &Leg1,
+    cos_tilt: f64,
+) -> LowerBranch {
     let g = &m.module;
     let (s, c) = (leg1.sin, leg1.cos);
     let dx2 = p.x + g.dx2;
-    // The lower root of (12) or (13) (s = -1) and its leg's state, as [`solve`] has them.
-    let lower = |leg: usize, l: f64, dy: f64, offset: f64| match leg_root(l, dx2, dy) {
-        Some(h) if h > FAST_MARGIN_MM => {
-            let rho = [offset - h, offset + h];
-            Ok(Some((
-                rho[0],
-                outer_leg_states(m, leg, (dx2, dy, h), rho, cos_tilt)[0],
-            )))
+    // The lower root of (12) or (13) (s = -1), whether its leg reaches and is fine there, and
+    // whether the square root is a close call; as [`leg_root`] and [`solve`] have them.
+    let lower = |leg: usize, l: f64, dy: f64, offset: f64| {
+        let arg = l * l - dx2 * dx2 - dy * dy;
+        let reaches = (arg >= -SQRT_ARG_REL * l * l) & arg.is_finite();
+        let h = arg.max(0.0).sqrt();
+        let close = (reaches & (h <= FAST_MARGIN_MM)) | (!reaches & (arg > -FAST_MARGIN_MM * l));
+        let rho = [offset - h, offset + h];
+        let state = outer_leg_states(m, leg, (dx2, dy, h), rho, cos_tilt)[0];
+        (rho[0], reaches & state.ok(), close)
+    };
+    // eq. (12): rho2 = zp - R2 sin a - sqrt(L2^2 - (xp + D2 - d2)^2 - (yp - R2 cos a + r4)^2)
+    let (rho2, ok2, close2) = lower(1, g.l2, p.y - g.r_big2 * c + g.r4, p.z - g.r_big2 * s);
+    // eq. (13): rho3 = zp + R2 sin a - sqrt(L3^2 - (xp + D2 - d2)^2 - (yp + R2 cos a - r4)^2)
+    let (rho3, ok3, close3) = lower(2, g.l3, p.y + g.r_big2 * c - g.r4, p.z + g.r_big2 * s);
+    let feasible = ok2
+        & ok3
+        & leg_state(m, 0, p, s, c, leg1.rho1, cos_tilt).ok()
+        & (g.r_big1 * c > g.r_small1);
+    LowerBranch {
+        branch: IkBranch {
+            alpha: leg1.alpha,
+            rho: Sliders::new(leg1.rho1, rho2, rho3),
+            config: WORKING_CONFIG,
+            verdict: Verdict::default(),
+        },
+        feasible,
+        close_call: close2 | close3,
+    }
+}
+
+/// A leg-I posture clear of the fast path's margins: R1 cos(alpha) > r1, away from alpha = 0
+/// (where the two postures of a root meet) and with s1 = -1.
+#[inline(always)]
+pub(crate) fn clear_of_margins(g: &ModuleGeometry, p: &Vector3<f64>, l: &Leg1) -> bool {
+    (g.r_big1 * l.cos - g.r_small1 > FAST_MARGIN_MM)
+        & (l.sin.abs() > FAST_MARGIN_RAD)
+        & (l.rho1 - p.z < -FAST_MARGIN_MM)
+}
+
+/// Points [`working_lanes`] runs side by side.
+pub const LANES: usize = 4;
+
+/// The working branch of each of N points, each alone (no continuity between them), when
+/// [`working_fast`]'s certified shortcut gives it: the posture from [`estimated_start`] by
+/// Chebyshev steps, certified ([`certified_posture`]); None for a point where it does not (the
+/// caller then runs [`solve_working_into`] for it, which says why). The points run in lockstep and without a
+/// branch, so the processor overlaps their dependency chains (a square root and a division for
+/// the start, a division and the sin/cos series for the step, two square roots for (12)-(13)).
+#[inline]
+pub fn working_lanes<const N: usize>(
+    m: &Machine,
+    pts: &[Vector3<f64>; N],
+) -> [Option<IkBranch>; N] {
+    let g = &m.module;
+    let ct = cos_tilt_max(m);
+    // Phase by phase over the points, in plain loops (the closures of array::from_fn are not
+    // always inlined, which would serialise the points again).
+    let mut out = [None; N];
+    let mut sure = [false; N];
+    let mut legs = [Leg1 {
+        alpha: 0.0,
+        rho1: 0.0,
+        sin: 0.0,
+        cos: 1.0,
+    }; N];
+    for k in 0..N {
+        let p = &pts[k];
+        let (start, usable) = estimated_start(g, p);
+        sure[k] = p.x.is_finite() & p.y.is_finite() & p.z.is_finite() & usable;
+        legs[k] = start;
+    }
+    // Chebyshev steps until every point has settled: one almost always near alpha = 0 (all
+    // points side by side, without a branch), two towards |alpha| = 0.2 (then only the points
+    // that need them).
+    let mut settled = [false; N];
+    for k in 0..N {
+        let step = Leg1Equations::new(g, &pts[k]).corrected_step(&legs[k]);
+        legs[k] = step.leg1;
+        sure[k] &= step.usable;
+        settled[k] = step.settled;
+    }
+    for k in 0..N {
+        for _ in 1..LEG1_MAX_STEPS {
+            if settled[k] | !sure[k] {
+                break;
+            }
+            let step = Leg1Equations::new(g, &pts[k]).corrected_step(&legs[k]);
+            legs[k] = step.leg1;
+            sure[k] &= step.usable;
+            settled[k] = step.settled;
         }
-        Some(_) => Err(()),
-        None if l * l - dx2 * dx2 - dy * dy > -FAST_MARGIN_MM * l => Err(()),
-        None => Ok(None),
-    };
-    let r2 = lower(1, g.l2, p.y - g.r_big2 * c + g.r4, p.z - g.r_big2 * s)?;
-    let r3 = lower(2, g.l3, p.y + g.r_big2 * c - g.r4, p.z + g.r_big2 * s)?;
-    let (Some((rho2, leg2)), Some((rho3, leg3))) = (r2, r3) else {
-        return Ok(None);
-    };
-    // Feasible: every leg as on the machine and inside its limits, rods of leg I not crossing
-    // (what [`combine`] of the three legs' verdicts says, without building it).
-    let feasible = leg_state(m, 0, p, s, c, leg1.rho1, cos_tilt).ok()
-        && leg2.ok()
-        && leg3.ok()
-        && g.r_big1 * c > g.r_small1;
-    Ok(feasible.then_some(IkBranch {
-        alpha: leg1.alpha,
-        rho: Sliders::new(leg1.rho1, rho2, rho3),
-        config: WORKING_CONFIG,
-        verdict: Verdict::default(),
-    }))
+    }
+    for k in 0..N {
+        sure[k] &= settled[k] & clear_of_margins(g, &pts[k], &legs[k]);
+    }
+    for k in 0..N {
+        sure[k] &= isolated_working_root(m, &pts[k]);
+    }
+    for k in 0..N {
+        let lower = lower_branch(m, &pts[k], &legs[k], ct);
+        sure[k] &= lower.feasible & !lower.close_call;
+        out[k] = sure[k].then_some(lower.branch);
+    }
+    out
 }
 
 /// A leg-I start near the posture with s1 = -1 on the root of (9) nearest cos(alpha) = 1,
 /// estimated without root isolation: eq. (14) about alpha = 0 with z - rho1 = h(alpha) from eq.
 /// (11), h(alpha)^2 = h0^2 - 2 R1 r1 (1 - cos alpha), to third order in alpha:
 ///   R1 h0 a + y (R1 - r1) - y R1 a^2 / 2 - R1 (h0 / 6 + R1 r1 / (2 h0)) a^3 = 0,
-/// solved by one correction of the first-order root a1 = -y (R1 - r1) / (R1 h0). None where
-/// y is near 0 (alpha = 0 is then a root and both its postures meet) or leg I cannot reach at
-/// alpha = 0.
-fn estimated_start(g: &ModuleGeometry, p: &Vector3<f64>) -> Option<Leg1> {
+/// solved by one correction of the first-order root a1 = -y (R1 - r1) / (R1 h0). Not usable
+/// (false) where y is near 0 (alpha = 0 is then a root and both its postures meet) or leg I
+/// cannot reach at alpha = 0. Without a branch, for [`working_lanes`].
+#[inline(always)]
+fn estimated_start(g: &ModuleGeometry, p: &Vector3<f64>) -> (Leg1, bool) {
     let (r, rr) = (g.r_big1, g.r_small1);
     let h0_sq = leg1_height_sq(g, p, 1.0);
-    if p.y.abs() < FAST_MARGIN_MM || h0_sq <= 0.0 {
-        return None;
-    }
+    let usable = (p.y.abs() >= FAST_MARGIN_MM) & (h0_sq > 0.0);
     let inv_h0 = 1.0 / h0_sq.sqrt();
     let a1 = -p.y * (r - rr) / r * inv_h0;
     let cubic = h0_sq * (1.0 / 6.0) + 0.5 * r * rr;
-    // Small enough for the series of sin_cos_after_step (|alpha| < 0.25).
+    // Inside the range of the sin/cos series (a NaN stays NaN and fails the first step).
     let alpha = (a1 + a1 * a1 * (0.5 * p.y + a1 * cubic * inv_h0) * inv_h0).clamp(-0.24, 0.24);
-    let (sin, cos) = sin_cos_after_step(0.0, 1.0, alpha, -alpha);
+    let (sin, cos) = sin_cos_small(alpha);
     // h(alpha) ~ h0 - R1 r1 (1 - cos alpha) / h0.
-    Some(Leg1 {
+    let start = Leg1 {
         alpha,
         rho1: p.z - (h0_sq - r * rr * (1.0 - cos)) * inv_h0,
         sin,
         cos,
-    })
-}
-
-/// [`crate::ik_track::certified_working`] from [`estimated_start`]: no cubic and no `acos` when
-/// Newton reaches the certified posture.
-fn certified_from_estimate(m: &Machine, p: &Vector3<f64>) -> Option<(IkBranch, Leg1)> {
-    let start = estimated_start(&m.module, p)?;
-    crate::ik_track::certified_working(m, p, start, cos_tilt_max(m))
+    };
+    (start, usable)
 }
 
 /// What `verne ik` needs for one point: the working branch alone when [`working_fast`] is sure
@@ -633,6 +810,36 @@ pub fn solve_working_into(m: &Machine, p: &Vector3<f64>, out: &mut IkBranches) {
     }
 }
 
+/// [`solve_working_into`] for each point of `rows` into its list, [`LANES`] points at a time
+/// through [`working_lanes`] (each point alone all the same: the lists are what
+/// [`solve_working_into`] gives, in the same order).
+pub fn solve_working_each<'a>(
+    m: &Machine,
+    rows: impl IntoIterator<Item = (Vector3<f64>, &'a mut IkBranches)>,
+) {
+    let mut pts = [Vector3::zeros(); LANES];
+    let mut outs = ArrayVec::<&'a mut IkBranches, LANES>::new();
+    for (p, out) in rows {
+        pts[outs.len()] = p;
+        outs.push(out);
+        if outs.is_full() {
+            let found = working_lanes(m, &pts);
+            for (k, out) in outs.drain(..).enumerate() {
+                match found[k] {
+                    Some(b) => {
+                        out.clear();
+                        out.push(b);
+                    }
+                    None => solve_working_into(m, &pts[k], out),
+                }
+            }
+        }
+    }
+    for (k, out) in outs.drain(..).enumerate() {
+        solve_working_into(m, &pts[k], out);
+    }
+}
+
 /// The machine's branch: the unique feasible one, or (if several are feasible, which the default
 /// machine never shows) the one with the smallest |alpha|.
 pub fn working(branches: &[IkBranch]) -> Option<&IkBranch> {
@@ -640,4 +847,62 @@ pub fn working(branches: &[IkBranch]) -> Option<&IkBranch> {
         .iter()
         .filter(|b| b.working())
         .min_by(|a, b| a.alpha.abs().total_cmp(&b.alpha.abs()))
+}
+
+// ------------------------------------------------------- the certificate of the working root
+
+// The working branch alone rests on this: every feasible branch has R1 cos(alpha) > r1 and
+// s1 = -1 (see [`crate::branches`]), and one root of (9) carries exactly one posture with
+// s1 = -1 (eq. (14) fixes the sign of alpha). So when the cubic (9) is certified to have one
+// root with R1 cos(alpha) > r1 (its derivative keeps one sign on [r1/R1, 1]: it is a parabola,
+// so its values at the ends and at its vertex decide), the working branch, if the point has
+// one, stands on the posture of that root with s1 = -1, with the lower roots of (12) and (13),
+// and Chebyshev steps on leg I from a good start find that posture without isolating
+// the cubic's roots.
+
+/// How far (relative to the cubic's largest coefficient) its derivative must stay from zero on
+/// [r1/R1, 1] for the root there to count as isolated.
+const MONOTONE_MARGIN: f64 = 1e-9;
+
+/// Chebyshev steps allowed to settle leg I from [`estimated_start`]: one almost always; more
+/// means the start was poor and the cubic answers.
+const LEG1_MAX_STEPS: usize = 6;
+
+/// The leg-I posture with s1 = -1 on the only root of the cubic (9) with R1 cos(alpha) > r1, by
+/// Chebyshev on leg I from `start`, when that root is certified to be alone there and the posture
+/// is clear of the fast path's margins; None when unsure.
+pub(crate) fn certified_posture(m: &Machine, p: &Vector3<f64>, start: Leg1) -> Option<Leg1> {
+    let g = &m.module;
+    if !p.iter().all(|v| v.is_finite()) || !isolated_working_root(m, p) {
+        return None;
+    }
+    let leg1 = newton_leg1(g, p, start, LEG1_MAX_STEPS)?;
+    clear_of_margins(g, p, &leg1).then_some(leg1)
+}
+
+/// True when the cubic (9) of `p` has at most one root with cos(alpha) in [r1/R1, 1] (slightly
+/// widened), certified by the sign of its derivative, which is a parabola opening upwards (the
+/// leading coefficient 2 R1^3 r1 is positive): negative at both ends means negative between;
+/// positive at both ends and at the vertex (when inside) means positive throughout.
+#[inline(always)]
+pub(crate) fn isolated_working_root(m: &Machine, p: &Vector3<f64>) -> bool {
+    let g = &m.module;
+    // The coefficients of (9) as cubic_eq9 has them, without its normalisation (no division):
+    // the margin is taken relative to the largest.
+    let [c0, c1, c2, c3] = eq9_coefficients(g, p);
+    // Plain comparisons (no NaN handling of f64::max): a NaN coefficient fails every test below.
+    let larger = |a: f64, b: f64| if a > b { a } else { b };
+    let largest = larger(larger(c0.abs(), c1.abs()), larger(c2.abs(), c3.abs()));
+    let margin = MONOTONE_MARGIN * largest;
+    let lo = (g.r_small1 / g.r_big1 - FAST_MARGIN_RAD).max(-1.0);
+    let d = |x: f64| (3.0 * c3 * x + 2.0 * c2) * x + c1;
+    let (d_lo, d_hi) = (d(lo), d(1.0));
+    // Vertex x_v = -c2 / (3 c3), where the derivative is c1 - c2^2 / (3 c3); c3 > 0.
+    let vertex_inside = (-c2 > 3.0 * c3 * lo) & (-c2 < 3.0 * c3);
+    let decreasing = (d_lo < -margin) & (d_hi < -margin);
+    let increasing = (d_lo > margin)
+        & (d_hi > margin)
+        & (!vertex_inside | (3.0 * c3 * c1 - c2 * c2 > 3.0 * c3 * margin));
+    // Without a branch (for working_lanes); a NaN fails every comparison.
+    (c3 > margin) & margin.is_finite() & (decreasing | increasing)
 }

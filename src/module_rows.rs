@@ -7,7 +7,6 @@ use nalgebra::Vector3;
 use crate::branches::{Config, Verdict};
 use crate::error::VerneError;
 use crate::fk_track::FkTracker;
-use crate::ik_track::IkTracker;
 use crate::machine::Machine;
 use crate::module_fk::{self, FkModes};
 use crate::module_ik::{self, IkBranches};
@@ -45,20 +44,19 @@ impl RowJob for ModuleIk {
         }
     }
 
-    /// The working branch is followed from row to row within a run ([`IkTracker`]); `--all`
-    /// solves every row completely.
+    /// The working branch of a run's rows, a few side by side
+    /// ([`module_ik::solve_working_each`]); `--all` solves every row completely.
     fn solve_run<'a>(&self, rows: &mut dyn Iterator<Item = (Option<&'a [f64]>, &'a mut IkBranches)>)
     where
         IkBranches: 'a,
     {
-        let mut tracker = IkTracker::new(&self.machine);
-        solve_rows(rows, |v, solved| {
-            if self.all {
-                self.solve(v, solved);
-            } else {
-                tracker.working_into(&Vector3::new(v[0], v[1], v[2]), solved);
-            }
-        });
+        if self.all {
+            solve_rows(rows, |v, solved| self.solve(v, solved));
+            return;
+        }
+        let present =
+            rows.filter_map(|(v, solved)| Some((Vector3::new(v?[0], v?[1], v?[2]), solved)));
+        module_ik::solve_working_each(&self.machine, present);
     }
 
     fn emit(&mut self, b: &IkBranches, out: &mut RowWriter<'_>) -> Result<RowOutcome, VerneError> {

@@ -17,30 +17,40 @@ pub fn sin_cos_after_step(sin_a: f64, cos_a: f64, alpha: f64, d: f64) -> (f64, f
             d * (1.0 - d2 * (1.0 / 6.0) * (1.0 - d2 * (1.0 / 20.0))),
             1.0 - d2 * 0.5 * (1.0 - d2 * (1.0 / 12.0)),
         )
-    } else if d.abs() < 0.25 {
-        // Next terms below d^13 / 13! and d^14 / 14!: under 1e-17 relative for |d| < 0.25.
-        let sd = d
-            * (1.0
-                - d2 * (1.0 / 6.0)
-                    * (1.0
-                        - d2 * (1.0 / 20.0)
-                            * (1.0
-                                - d2 * (1.0 / 42.0)
-                                    * (1.0 - d2 * (1.0 / 72.0) * (1.0 - d2 * (1.0 / 110.0))))));
-        let cd = 1.0
-            - d2 * 0.5
-                * (1.0
-                    - d2 * (1.0 / 12.0)
-                        * (1.0
-                            - d2 * (1.0 / 30.0)
-                                * (1.0
-                                    - d2 * (1.0 / 56.0)
-                                        * (1.0 - d2 * (1.0 / 90.0) * (1.0 - d2 * (1.0 / 132.0))))));
-        (sd, cd)
+    } else if d.abs() < SMALL_ANGLE {
+        sin_cos_small(d)
     } else {
         return alpha.sin_cos();
     };
     (sin_a * cd - cos_a * sd, cos_a * cd + sin_a * sd)
+}
+
+/// Largest |d| for [`sin_cos_small`].
+pub const SMALL_ANGLE: f64 = 0.25;
+
+/// sin d and cos d for |d| < [`SMALL_ANGLE`] by their series, without a branch. The next terms
+/// are below d^13 / 13! and d^14 / 14!: under 1e-17 relative for |d| < 0.25.
+#[inline(always)]
+pub fn sin_cos_small(d: f64) -> (f64, f64) {
+    let d2 = d * d;
+    let sd = d
+        * (1.0
+            - d2 * (1.0 / 6.0)
+                * (1.0
+                    - d2 * (1.0 / 20.0)
+                        * (1.0
+                            - d2 * (1.0 / 42.0)
+                                * (1.0 - d2 * (1.0 / 72.0) * (1.0 - d2 * (1.0 / 110.0))))));
+    let cd = 1.0
+        - d2 * 0.5
+            * (1.0
+                - d2 * (1.0 / 12.0)
+                    * (1.0
+                        - d2 * (1.0 / 30.0)
+                            * (1.0
+                                - d2 * (1.0 / 56.0)
+                                    * (1.0 - d2 * (1.0 / 90.0) * (1.0 - d2 * (1.0 / 132.0))))));
+    (sd, cd)
 }
 
 /// Highest harmonic kept.

@@ -1,7 +1,8 @@
 //! The fast paths give what the complete solvers give: `module_ik::working_fast` (the working
-//! branch alone) against `module_ik::working(module_ik::solve(..))`, over a dense grid of the
-//! reachable space, random points, and the neighbourhoods where it must hand over to the complete
-//! solver (alpha = 0, y_p = 0, R1 cos(alpha) = r1, joint limits).
+//! branch alone) and `module_ik::solve_working_each` (four points side by side) against
+//! `module_ik::working(module_ik::solve(..))`, over a dense grid of the reachable space, random
+//! points, and the neighbourhoods where they must hand over to the complete solver (alpha = 0,
+//! y_p = 0, R1 cos(alpha) = r1, joint limits); the FK tracker against `module_fk::solve`.
 
 use nalgebra::Vector3;
 use verne::machine::Machine;
@@ -277,33 +278,37 @@ fn tracked_fk_matches_the_complete_solver_through_branch_switches() {
     );
 }
 
-// ------------------------------------------------------------ IK: the working branch tracked
+// ------------------------------------------------- IK: the working branch, points side by side
 
-use verne::ik_track::IkTracker;
-
-/// Compares the tracked working branch with the complete solver's on every point of a path;
-/// returns (points with a working branch, points answered by tracking).
-fn ik_tracked_agrees(m: &Machine, path: &[Vector3<f64>]) -> (usize, u64) {
-    let mut tracker = IkTracker::new(m);
-    let mut got = IkBranches::new();
+/// Compares the working branch of every point of `path`, solved LANES at a time
+/// (`module_ik::solve_working_each`, as `verne ik` does), with the complete solver's; returns
+/// (points with a working branch, points `module_ik::working_lanes` answered alone).
+fn lanes_agree(m: &Machine, path: &[Vector3<f64>]) -> (usize, usize) {
+    let mut got = vec![IkBranches::new(); path.len()];
+    module_ik::solve_working_each(m, path.iter().copied().zip(got.iter_mut()));
     let mut present = 0;
-    for p in path {
-        tracker.working_into(p, &mut got);
-        let t = module_ik::working(&got).copied();
+    for (p, got) in path.iter().zip(&got) {
+        let t = module_ik::working(got).copied();
         let full = module_ik::solve(m, p);
         let e = module_ik::working(&full);
-        assert_eq!(t.is_some(), e.is_some(), "p={p:?}: tracked {t:?} vs {e:?}");
+        assert_eq!(t.is_some(), e.is_some(), "p={p:?}: lanes {t:?} vs {e:?}");
         if let (Some(t), Some(e)) = (t, e) {
             present += 1;
             let (da, dr) = ((t.alpha - e.alpha).abs(), (t.rho - e.rho).amax());
             assert!(
                 da < 1e-12 && dr < 1e-9 && t.config == e.config && t.verdict == e.verdict,
-                "p={p:?}: tracked {t:?} vs {e:?} (d alpha {da:e}, d rho {dr:e})"
+                "p={p:?}: lanes {t:?} vs {e:?} (d alpha {da:e}, d rho {dr:e})"
             );
         }
     }
-    assert_eq!(tracker.tracked + tracker.solved, path.len() as u64);
-    (present, tracker.tracked)
+    let by_lanes = path
+        .chunks_exact(module_ik::LANES)
+        .map(|c| {
+            let c: &[Vector3<f64>; module_ik::LANES] = c.try_into().unwrap();
+            module_ik::working_lanes(m, c).iter().flatten().count()
+        })
+        .sum();
+    (present, by_lanes)
 }
 
 fn helix_points(rows: usize) -> Vec<Vector3<f64>> {
@@ -321,40 +326,37 @@ fn helix_points(rows: usize) -> Vec<Vector3<f64>> {
 }
 
 #[test]
-fn tracked_ik_matches_the_complete_solver_along_a_helix() {
+fn lanes_match_the_complete_solver_along_a_helix() {
     let m = Machine::default_verne();
     let path = helix_points(4096);
-    let (present, tracked) = ik_tracked_agrees(&m, &path);
+    let (present, by_lanes) = lanes_agree(&m, &path);
     assert_eq!(present, path.len());
     // The helix crosses y_p = 0 twice (alpha = 0: handed over within the margin); every other
-    // row is tracked.
-    assert!(
-        tracked as usize >= path.len() - 8,
-        "{tracked} of {}",
-        path.len()
-    );
+    // point is answered in one step from the estimate.
+    assert!(by_lanes >= path.len() - 8, "{by_lanes} of {}", path.len());
 }
 
-/// Without continuity the tracker still answers right (Newton from an unrelated posture either
-/// reaches the certified posture or hands over).
+/// Points all over and around the reachable space, the feasible ones among them answered by
+/// the lanes almost always.
 #[test]
-fn tracked_ik_matches_the_complete_solver_on_scattered_points() {
+fn lanes_match_the_complete_solver_on_scattered_points() {
     let m = Machine::default_verne();
     let pts = random_points(5, 20_000);
-    let (present, tracked) = ik_tracked_agrees(&m, &pts);
-    eprintln!("{present} with a working branch, {tracked} tracked");
+    let (present, by_lanes) = lanes_agree(&m, &pts);
+    eprintln!("{present} with a working branch, {by_lanes} by the lanes");
     assert!(present > 1000);
+    assert!(by_lanes * 100 > present * 95, "{by_lanes} of {present}");
 }
 
 /// Along rays through the places where the working branch ends (a joint or rod limit, two
 /// roots of (9) meeting, rods of leg I crossing) and across y_p = 0 (alpha through 0, where the
 /// two postures of a root meet), forwards and back at 0.05 mm per row.
 #[test]
-fn tracked_ik_matches_the_complete_solver_through_hand_over_places() {
+fn lanes_match_the_complete_solver_through_hand_over_places() {
     let m = Machine::default_verne();
     let starts = helix_points(64);
     let mut r = Lcg(13);
-    let (mut crossings, mut rows_present, mut tracked) = (0, 0, 0);
+    let (mut crossings, mut rows_present, mut by_lanes) = (0, 0, 0);
     let has = |p: Vector3<f64>| module_ik::working(&module_ik::solve(&m, &p)).is_some();
     let mut rays = Vec::new();
     for start in &starts {
@@ -383,17 +385,17 @@ fn tracked_ik_matches_the_complete_solver_through_hand_over_places() {
             (0..=400).map(|k| from + dir * (0.05 * k as f64)).collect();
         let back: Vec<Vector3<f64>> = forward.iter().rev().copied().collect();
         for path in [forward, back] {
-            let (present, t) = ik_tracked_agrees(&m, &path);
+            let (present, t) = lanes_agree(&m, &path);
             rows_present += present;
-            tracked += t as usize;
+            by_lanes += t;
         }
     }
     eprintln!(
-        "{crossings} crossings; {tracked} of {rows_present} rows with a working branch tracked"
+        "{crossings} crossings; {by_lanes} of {rows_present} rows with a working branch by the lanes"
     );
     assert!(crossings > 200, "{crossings} crossings");
     assert!(
-        tracked * 10 > rows_present * 9,
-        "{tracked} of {rows_present}"
+        by_lanes * 10 > rows_present * 9,
+        "{by_lanes} of {rows_present}"
     );
 }
