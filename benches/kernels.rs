@@ -535,6 +535,19 @@ impl Fixture {
             .sum()
     }
 
+    /// Every branch of every point in runs of RUN_ROWS through `module_ik::solve_each` (as
+    /// `verne ik --all` does: LANES points side by side, into lists reused from run to run).
+    fn run_ik_all_lanes(&self, pts: &[Vector3<f64>]) -> usize {
+        let mut slots = self.ik_slots.lock().expect("one benchmark at a time");
+        let mut n = 0;
+        for run in pts.chunks(RUN_ROWS) {
+            let rows = run.iter().map(|p| *black_box(p)).zip(slots.iter_mut());
+            module_ik::solve_each(&self.machine, rows);
+            n += slots[..run.len()].iter().map(|b| b.len()).sum::<usize>();
+        }
+        n
+    }
+
     fn run_newton_ik(&self) -> (f64, u64) {
         let g = &self.machine.module;
         let mut q = self.path_joints[0];
@@ -929,7 +942,13 @@ const KERNELS: &[(&str, &str, &str, &str)] = &[
         "ik/all_branches",
         "module pose",
         "ik/newton_warm",
-        "< 250 ns/pose (all sixteen branches)",
+        "< 250 ns/pose (all sixteen branches, each point alone)",
+    ),
+    (
+        "ik/all_branches_lanes",
+        "module pose",
+        "ik/newton_warm",
+        "< 250 ns/pose (all sixteen branches, four side by side, as `verne ik --all`)",
     ),
     (
         "ik/working_branch_scattered",
@@ -1074,6 +1093,9 @@ fn main() {
     });
     bench(&mut c, &rec, "ik", "all_branches", n, || {
         fx.run_ik_all(&fx.path)
+    });
+    bench(&mut c, &rec, "ik", "all_branches_lanes", n, || {
+        fx.run_ik_all_lanes(&fx.path)
     });
     bench(&mut c, &rec, "ik", "working_branch_scattered", n, || {
         fx.run_ik_working(&fx.scatter)

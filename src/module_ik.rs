@@ -81,32 +81,16 @@ fn leg1_height_sq(g: &ModuleGeometry, p: &Vector3<f64>, c: f64) -> f64 {
     k1 - u * u - p.y * p.y
 }
 
-/// Every real leg-I posture (alpha, rho1) for the point into `out`: eqs. (9), (11), (14),
-/// polished by Newton on eqs. (10) and (14) (the half-sum and half-difference of (3) and (4)).
-fn leg1_postures_into(m: &Machine, p: &Vector3<f64>, out: &mut ArrayVec<Leg1, 6>) {
-    let g = &m.module;
-    let (r, rr) = (g.r_big1, g.r_small1);
-    out.clear();
+/// The roots of eq. (9) in cos(alpha) other than the certified one (`certified`: the point's
+/// [`certified_lanes`] posture, when it has one), in increasing order: all of them without it.
+/// With it, the others are all below r1/R1: from the cubic divided by the known root (no
+/// isolation), unless that is a close call. Empty when the cubic is degenerate.
+fn other_roots(g: &ModuleGeometry, p: &Vector3<f64>, certified: Option<Leg1>) -> ArrayVec<f64, 8> {
     let Some(coeffs) = cubic_eq9(g, p) else {
-        return;
+        return ArrayVec::new();
     };
-    let mut push = |l: Leg1| {
-        let dup = out.iter().any(|o: &Leg1| {
-            (o.rho1 - l.rho1).abs() < 1e-7 && angle_diff(o.alpha, l.alpha).abs() < SAME_SOLUTION_RAD
-        });
-        if !dup && !out.is_full() {
-            out.push(l);
-        }
-    };
-    // The root with R1 cos(alpha) > r1, when it is certified alone there, by Chebyshev on leg I
-    // from an estimate (no isolation, no acos, no separate polish); the other roots, all below
-    // r1/R1 then, from the cubic divided by it, or by isolation when that is a close call.
-    let certified = match estimated_start(g, p) {
-        (start, true) => certified_posture(m, p, start),
-        _ => None,
-    };
-    let roots: ArrayVec<f64, 8> = match certified {
-        // Below r1/R1: the cubic divided by the known root, unless that is a close call.
+    let (r, rr) = (g.r_big1, g.r_small1);
+    match certified {
         Some(leg1) => {
             let hi = rr / r - FAST_MARGIN_RAD;
             match deflated_roots_in(&coeffs, leg1.cos, -1.0, hi) {
@@ -121,8 +105,32 @@ fn leg1_postures_into(m: &Machine, p: &Vector3<f64>, out: &mut ArrayVec<Leg1, 6>
             .iter()
             .map(|t| t.x)
             .collect(),
+    }
+}
+
+/// Every real leg-I posture (alpha, rho1) for the point into `out`: those of `roots` (from
+/// [`other_roots`]) by eqs. (11) and (14), polished by Newton on eqs. (10) and (14) (the
+/// half-sum and half-difference of (3) and (4)), then the certified one; each with its mirror
+/// image, or where sin(alpha) = 0 both signs of eq. (11) (Table II). A posture met before is
+/// left out.
+fn leg1_postures_into(
+    g: &ModuleGeometry,
+    p: &Vector3<f64>,
+    roots: &[f64],
+    certified: Option<Leg1>,
+    out: &mut ArrayVec<Leg1, 6>,
+) {
+    let (r, rr) = (g.r_big1, g.r_small1);
+    out.clear();
+    let mut push = |l: Leg1| {
+        let dup = out.iter().any(|o: &Leg1| {
+            (o.rho1 - l.rho1).abs() < 1e-7 && angle_diff(o.alpha, l.alpha).abs() < SAME_SOLUTION_RAD
+        });
+        if !dup && !out.is_full() {
+            out.push(l);
+        }
     };
-    for root in roots {
+    for &root in roots {
         let c = root.clamp(-1.0, 1.0);
         let sin_a = ((1.0 - c) * (1.0 + c)).sqrt();
         let h2 = leg1_height_sq(g, p, c);
@@ -220,32 +228,6 @@ fn polish_leg1(g: &ModuleGeometry, p: &Vector3<f64>, start: Leg1) -> Leg1 {
         }
     }
     with_wrapped_alpha(best.0)
-}
-
-/// Chebyshev's method on eqs. (10) and (14) from `start` ([`Leg1Equations::corrected_step`]),
-/// step after step, until a step settles the posture (it, or the error it predicts is left, is
-/// below [`NEWTON_STEP_STOP`]: converged to rounding); None when that takes more than
-/// `max_steps` steps, or a step is singular or too long for the sin/cos series.
-#[inline]
-pub(crate) fn newton_leg1(
-    g: &ModuleGeometry,
-    p: &Vector3<f64>,
-    start: Leg1,
-    max_steps: usize,
-) -> Option<Leg1> {
-    let eqs = Leg1Equations::new(g, p);
-    let mut cur = start;
-    for _ in 0..max_steps {
-        let step = eqs.corrected_step(&cur);
-        if !step.usable {
-            return None;
-        }
-        cur = step.leg1;
-        if step.settled {
-            return Some(with_wrapped_alpha(cur));
-        }
-    }
-    None
 }
 
 /// One step of [`Leg1Equations::corrected_step`].
@@ -474,6 +456,70 @@ pub fn solve(m: &Machine, p: &Vector3<f64>) -> IkBranches {
 
 /// [`solve`] into an existing list (cleared first), so a caller that keeps one avoids copying it.
 pub fn solve_into(m: &Machine, p: &Vector3<f64>, out: &mut IkBranches) {
+    let ([leg1], [certified]) = certified_lanes(m, &[*p]);
+    let certified = certified.then_some(leg1);
+    let g = &m.module;
+    let roots = other_roots(g, p, certified);
+    let mut legs1 = ArrayVec::<Leg1, 6>::new();
+    leg1_postures_into(g, p, &roots, certified, &mut legs1);
+    branches_into(m, p, &legs1, out);
+}
+
+/// [`solve_into`] for each point of `rows` into its list, [`LANES`] points at a time: the
+/// certified root of (9) side by side ([`certified_lanes`]), then each point's other roots, its
+/// postures, its branches, phase by phase (each point alone all the same: the lists are what [`solve_into`]
+/// gives).
+pub fn solve_each<'a>(
+    m: &Machine,
+    rows: impl IntoIterator<Item = (Vector3<f64>, &'a mut IkBranches)>,
+) {
+    in_lanes(
+        rows,
+        |pts, outs| {
+            let (legs, certified) = certified_lanes(m, pts);
+            let certified: [Option<Leg1>; LANES] =
+                std::array::from_fn(|k| certified[k].then_some(legs[k]));
+            let g = &m.module;
+            let mut roots: [ArrayVec<f64, 8>; LANES] = Default::default();
+            for k in 0..LANES {
+                roots[k] = other_roots(g, &pts[k], certified[k]);
+            }
+            let mut postures: [ArrayVec<Leg1, 6>; LANES] = Default::default();
+            for k in 0..LANES {
+                leg1_postures_into(g, &pts[k], &roots[k], certified[k], &mut postures[k]);
+            }
+            for (k, out) in outs.enumerate() {
+                branches_into(m, &pts[k], &postures[k], out);
+            }
+        },
+        |p, out| solve_into(m, p, out),
+    );
+}
+
+/// Groups `rows` by [`LANES`] for `group` (the points and their lists, in order), the last few
+/// one by one for `single`.
+fn in_lanes<'a>(
+    rows: impl IntoIterator<Item = (Vector3<f64>, &'a mut IkBranches)>,
+    mut group: impl FnMut(&[Vector3<f64>; LANES], &mut dyn Iterator<Item = &'a mut IkBranches>),
+    mut single: impl FnMut(&Vector3<f64>, &mut IkBranches),
+) {
+    let mut pts = [Vector3::zeros(); LANES];
+    let mut outs = ArrayVec::<&'a mut IkBranches, LANES>::new();
+    for (p, out) in rows {
+        pts[outs.len()] = p;
+        outs.push(out);
+        if outs.is_full() {
+            group(&pts, &mut outs.drain(..));
+        }
+    }
+    for (k, out) in outs.drain(..).enumerate() {
+        single(&pts[k], out);
+    }
+}
+
+/// Every branch on the leg-I postures `legs1` of `p` into `out` (cleared first), ordered and
+/// labelled as [`solve`] gives them.
+fn branches_into(m: &Machine, p: &Vector3<f64>, legs1: &ArrayVec<Leg1, 6>, out: &mut IkBranches) {
     let g = &m.module;
     out.clear();
     if !p.iter().all(|v| v.is_finite()) {
@@ -482,8 +528,6 @@ pub fn solve_into(m: &Machine, p: &Vector3<f64>, out: &mut IkBranches) {
     let cos_tilt = cos_tilt_max(m);
     // Branches come out ordered by alpha, then (s1, s2, s3): postures sorted by (alpha, s1), and
     // within a posture s2, s3 = -1 before +1 (the roots of (12)-(13) in increasing order).
-    let mut legs1 = ArrayVec::<Leg1, 6>::new();
-    leg1_postures_into(m, p, &mut legs1);
     let n = legs1.len();
     let mut checks = [(0i8, Verdict::default()); 6];
     for (k, l) in legs1.iter().enumerate() {
@@ -707,21 +751,37 @@ pub(crate) fn clear_of_margins(g: &ModuleGeometry, p: &Vector3<f64>, l: &Leg1) -
 pub const LANES: usize = 4;
 
 /// The working branch of each of N points, each alone (no continuity between them), when
-/// [`working_fast`]'s certified shortcut gives it: the posture from [`estimated_start`] by
-/// Chebyshev steps, certified ([`certified_posture`]); None for a point where it does not (the
-/// caller then runs [`solve_working_into`] for it, which says why). The points run in lockstep and without a
-/// branch, so the processor overlaps their dependency chains (a square root and a division for
-/// the start, a division and the sin/cos series for the step, two square roots for (12)-(13)).
+/// [`working_fast`]'s certified shortcut gives it: the posture of [`certified_lanes`] with the
+/// lower roots of (12)-(13), feasible and clear of the margins; None for a point where it does
+/// not (the caller then runs [`solve_working_into`] for it, which says why). The points run in
+/// lockstep and without a branch, so the processor overlaps their dependency chains (a square
+/// root and a division for the start, a division and the sin/cos series for the step, two
+/// square roots for (12)-(13)).
 #[inline]
 pub fn working_lanes<const N: usize>(
     m: &Machine,
     pts: &[Vector3<f64>; N],
 ) -> [Option<IkBranch>; N] {
-    let g = &m.module;
     let ct = cos_tilt_max(m);
-    // Phase by phase over the points, in plain loops (the closures of array::from_fn are not
-    // always inlined, which would serialise the points again).
+    let (legs, mut sure) = certified_lanes(m, pts);
     let mut out = [None; N];
+    for k in 0..N {
+        let lower = lower_branch(m, &pts[k], &legs[k], ct);
+        sure[k] &= lower.feasible & !lower.close_call;
+        out[k] = sure[k].then_some(lower.branch);
+    }
+    out
+}
+
+/// For each of N points, the leg-I posture with s1 = -1 on the only root of the cubic (9) with
+/// R1 cos(alpha) > r1, with true when it is certified (see the section on the certificate
+/// below): Chebyshev steps on leg I from [`estimated_start`] until one settles, at most
+/// [`LEG1_MAX_STEPS`], the posture clear of the fast path's margins and the root alone on
+/// [r1/R1, 1]. The points run side by side, phase by phase, in plain loops (the closures of
+/// `array::from_fn` are not always inlined, which would serialise the points again).
+#[inline(always)]
+fn certified_lanes<const N: usize>(m: &Machine, pts: &[Vector3<f64>; N]) -> ([Leg1; N], [bool; N]) {
+    let g = &m.module;
     let mut sure = [false; N];
     let mut legs = [Leg1 {
         alpha: 0.0,
@@ -737,7 +797,7 @@ pub fn working_lanes<const N: usize>(
     }
     // Chebyshev steps until every point has settled: one almost always near alpha = 0 (all
     // points side by side, without a branch), two towards |alpha| = 0.2 (then only the points
-    // that need them).
+    // that need them). |alpha| stays below 0.24 + 6 x 0.25 < pi: no wrapping.
     let mut settled = [false; N];
     for k in 0..N {
         let step = Leg1Equations::new(g, &pts[k]).corrected_step(&legs[k]);
@@ -757,17 +817,10 @@ pub fn working_lanes<const N: usize>(
         }
     }
     for k in 0..N {
-        sure[k] &= settled[k] & clear_of_margins(g, &pts[k], &legs[k]);
+        sure[k] &=
+            settled[k] & clear_of_margins(g, &pts[k], &legs[k]) & isolated_working_root(m, &pts[k]);
     }
-    for k in 0..N {
-        sure[k] &= isolated_working_root(m, &pts[k]);
-    }
-    for k in 0..N {
-        let lower = lower_branch(m, &pts[k], &legs[k], ct);
-        sure[k] &= lower.feasible & !lower.close_call;
-        out[k] = sure[k].then_some(lower.branch);
-    }
-    out
+    (legs, sure)
 }
 
 /// A leg-I start near the posture with s1 = -1 on the root of (9) nearest cos(alpha) = 1,
@@ -817,14 +870,11 @@ pub fn solve_working_each<'a>(
     m: &Machine,
     rows: impl IntoIterator<Item = (Vector3<f64>, &'a mut IkBranches)>,
 ) {
-    let mut pts = [Vector3::zeros(); LANES];
-    let mut outs = ArrayVec::<&'a mut IkBranches, LANES>::new();
-    for (p, out) in rows {
-        pts[outs.len()] = p;
-        outs.push(out);
-        if outs.is_full() {
-            let found = working_lanes(m, &pts);
-            for (k, out) in outs.drain(..).enumerate() {
+    in_lanes(
+        rows,
+        |pts, outs| {
+            let found = working_lanes(m, pts);
+            for (k, out) in outs.enumerate() {
                 match found[k] {
                     Some(b) => {
                         out.clear();
@@ -833,11 +883,9 @@ pub fn solve_working_each<'a>(
                     None => solve_working_into(m, &pts[k], out),
                 }
             }
-        }
-    }
-    for (k, out) in outs.drain(..).enumerate() {
-        solve_working_into(m, &pts[k], out);
-    }
+        },
+        |p, out| solve_working_into(m, p, out),
+    );
 }
 
 /// The machine's branch: the unique feasible one, or (if several are feasible, which the default
@@ -867,18 +915,6 @@ const MONOTONE_MARGIN: f64 = 1e-9;
 /// Chebyshev steps allowed to settle leg I from [`estimated_start`]: one almost always; more
 /// means the start was poor and the cubic answers.
 const LEG1_MAX_STEPS: usize = 6;
-
-/// The leg-I posture with s1 = -1 on the only root of the cubic (9) with R1 cos(alpha) > r1, by
-/// Chebyshev on leg I from `start`, when that root is certified to be alone there and the posture
-/// is clear of the fast path's margins; None when unsure.
-pub(crate) fn certified_posture(m: &Machine, p: &Vector3<f64>, start: Leg1) -> Option<Leg1> {
-    let g = &m.module;
-    if !p.iter().all(|v| v.is_finite()) || !isolated_working_root(m, p) {
-        return None;
-    }
-    let leg1 = newton_leg1(g, p, start, LEG1_MAX_STEPS)?;
-    clear_of_margins(g, p, &leg1).then_some(leg1)
-}
 
 /// True when the cubic (9) of `p` has at most one root with cos(alpha) in [r1/R1, 1] (slightly
 /// widened), certified by the sign of its derivative, which is a parabola opening upwards (the

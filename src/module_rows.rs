@@ -44,19 +44,19 @@ impl RowJob for ModuleIk {
         }
     }
 
-    /// The working branch of a run's rows, a few side by side
-    /// ([`module_ik::solve_working_each`]); `--all` solves every row completely.
+    /// A run's rows a few side by side: the working branch ([`module_ik::solve_working_each`]),
+    /// or every branch with `--all` ([`module_ik::solve_each`]).
     fn solve_run<'a>(&self, rows: &mut dyn Iterator<Item = (Option<&'a [f64]>, &'a mut IkBranches)>)
     where
         IkBranches: 'a,
     {
-        if self.all {
-            solve_rows(rows, |v, solved| self.solve(v, solved));
-            return;
-        }
         let present =
             rows.filter_map(|(v, solved)| Some((Vector3::new(v?[0], v?[1], v?[2]), solved)));
-        module_ik::solve_working_each(&self.machine, present);
+        if self.all {
+            module_ik::solve_each(&self.machine, present);
+        } else {
+            module_ik::solve_working_each(&self.machine, present);
+        }
     }
 
     fn emit(&mut self, b: &IkBranches, out: &mut RowWriter<'_>) -> Result<RowOutcome, VerneError> {

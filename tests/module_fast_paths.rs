@@ -325,6 +325,27 @@ fn helix_points(rows: usize) -> Vec<Vector3<f64>> {
         .collect()
 }
 
+/// `module_ik::solve_each` (four points side by side, as `verne ik --all`) gives exactly the
+/// lists `module_ik::solve` gives, branch for branch and bit for bit, whatever the grouping.
+#[test]
+fn solve_each_gives_solves_lists() {
+    let m = Machine::default_verne();
+    let mut pts = helix_points(1024);
+    pts.extend(random_points(17, 20_000));
+    // y_p = 0 (alpha = 0 roots, both signs of eq. (11)) and near it.
+    pts.extend(
+        (0..400).map(|k| Vector3::new(-250.0, [0.0, 1e-9, -1e-7, 1e-4][k % 4], 1000.0 + k as f64)),
+    );
+    for skip in [0, 1, 3] {
+        let mut got = vec![IkBranches::new(); pts.len() - skip];
+        module_ik::solve_each(&m, pts[skip..].iter().copied().zip(got.iter_mut()));
+        for (p, got) in pts[skip..].iter().zip(&got) {
+            let expected = module_ik::solve(&m, p);
+            assert_eq!(got.as_slice(), expected.as_slice(), "p={p:?}");
+        }
+    }
+}
+
 #[test]
 fn lanes_match_the_complete_solver_along_a_helix() {
     let m = Machine::default_verne();
