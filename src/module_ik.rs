@@ -3,6 +3,12 @@
 //!
 //! alpha comes from the cubic in cos(alpha) of eq. (9), rho1 from eq. (14) (both signs of eq. (11)
 //! where sin(alpha) = 0, Table II), rho2 and rho3 from eqs. (12)-(13) with both signs.
+//!
+//! The root of (9) a feasible branch can stand on (R1 cos(alpha) > r1) comes, when certified
+//! alone, from Chebyshev steps on leg I's equations (10) and (14) from an estimate, without
+//! isolating the cubic (the section on the certificate at the end). Many points are solved side
+//! by side ([`solve_each`], [`solve_working_each`]; [`LANES`] at a time), each alone all the
+//! same, so that the processor overlaps their chains of square roots and divisions.
 
 use arrayvec::ArrayVec;
 use nalgebra::Vector3;
@@ -466,9 +472,9 @@ pub fn solve_into(m: &Machine, p: &Vector3<f64>, out: &mut IkBranches) {
 }
 
 /// [`solve_into`] for each point of `rows` into its list, [`LANES`] points at a time: the
-/// certified root of (9) side by side ([`certified_lanes`]), then each point's other roots, its
-/// postures, its branches, phase by phase (each point alone all the same: the lists are what [`solve_into`]
-/// gives).
+/// certified root of (9) side by side (`certified_lanes`), then each point's other roots, its
+/// postures, its branches, phase by phase (each point alone all the same: the lists are what
+/// [`solve_into`] gives).
 pub fn solve_each<'a>(
     m: &Machine,
     rows: impl IntoIterator<Item = (Vector3<f64>, &'a mut IkBranches)>,
@@ -597,7 +603,8 @@ pub(crate) const FAST_MARGIN_RAD: f64 = 1e-6;
 
 /// The working branch alone, without building the others, when the decision is clear-cut; None
 /// when unsure or when there is no feasible branch (the caller then runs [`solve`], which also
-/// says why). Only what can be feasible is built: a feasible branch has s = (-1, -1, -1) and
+/// says why). First [`working_lanes`] for this one point (the certified posture, no cubic);
+/// otherwise only what can be feasible is built: a feasible branch has s = (-1, -1, -1) and
 /// R1 cos(alpha) > r1 (see [`crate::branches`]), so only the roots of eq. (9) with
 /// cos(alpha) > r1/R1 are kept, with the sign of alpha that makes s1 = -1 in eq. (14) and the
 /// lower roots of (12)-(13). Every step is the one [`solve`] takes for that branch; the margins
@@ -751,7 +758,7 @@ pub(crate) fn clear_of_margins(g: &ModuleGeometry, p: &Vector3<f64>, l: &Leg1) -
 pub const LANES: usize = 4;
 
 /// The working branch of each of N points, each alone (no continuity between them), when
-/// [`working_fast`]'s certified shortcut gives it: the posture of [`certified_lanes`] with the
+/// [`working_fast`]'s certified shortcut gives it: the posture of `certified_lanes` with the
 /// lower roots of (12)-(13), feasible and clear of the margins; None for a point where it does
 /// not (the caller then runs [`solve_working_into`] for it, which says why). The points run in
 /// lockstep and without a branch, so the processor overlaps their dependency chains (a square

@@ -234,7 +234,7 @@ pub struct WorkspaceOptions {
     pub lambda: [f64; 2],
 }
 
-/// A regular grid: points origin + step (i, j, k), 0 <= i < n[0], ...
+/// A regular grid: points origin + step (i, j, k), 0 <= i < `n[0]`, ...
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Grid {
     pub origin: Vector3<f64>,

@@ -256,7 +256,7 @@ pub fn architecture_spec(arch: Architecture, l: f64, bounds: [f64; 2]) -> Option
 
 /// Axis-aligned bounding box area of the mechanism over its joint box: guide origins A and B,
 /// the guide strokes, and P (forward kinematics in the `+` assembly mode) on a
-/// [`ENVELOPE_JOINT_SAMPLES`]^2 grid of the joint box.
+/// `ENVELOPE_JOINT_SAMPLES`^2 grid of the joint box.
 pub fn envelope(spec: &GliderSpec) -> f64 {
     let n = ENVELOPE_JOINT_SAMPLES;
     let lerp = |[lo, hi]: [f64; 2], k: usize| lo + (hi - lo) * k as f64 / (n - 1) as f64;
