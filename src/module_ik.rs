@@ -381,7 +381,7 @@ impl Leg1Equations {
             sin: s * cd - c * sd,
             cos: c * cd + s * sd,
         };
-        let usable = step[0].abs() < SMALL_ANGLE && step[1].is_finite();
+        let usable = (step[0].abs() < SMALL_ANGLE) & step[1].is_finite();
         let rho_stop = NEWTON_STEP_STOP * (1.0 + leg1.rho1.abs());
         // What is left is J^-1 (H[d, k] - T[d, d, d] / 6), k = step - d the correction, T the
         // third derivatives (g1_aaa = -2 R1 r1 sin a; g2_aaa = y R1 sin a - R1 cos a (z - rho1),
