@@ -535,16 +535,15 @@ impl Fixture {
             .sum()
     }
 
-    /// Every branch of every point in runs of RUN_ROWS through `module_ik::solve_each` (as
-    /// `verne ik --all` does: LANES points side by side, into lists reused from run to run).
+    /// Every branch of every point of `pts`, each alone, in runs of RUN_ROWS through
+    /// `module_ik::solve_each` (as `verne ik --all` does); returns the number of branches.
     fn run_ik_all_lanes(&self, pts: &[Vector3<f64>]) -> usize {
-        let mut slots = self.ik_slots.lock().expect("one benchmark at a time");
         let mut n = 0;
-        for run in pts.chunks(RUN_ROWS) {
-            let rows = run.iter().map(|p| *black_box(p)).zip(slots.iter_mut());
-            module_ik::solve_each(&self.machine, rows);
-            n += slots[..run.len()].iter().map(|b| b.len()).sum::<usize>();
-        }
+        self.run_ik_runs(
+            pts,
+            |m, rows| module_ik::solve_each(m, rows),
+            |_, b| n += b.len(),
+        );
         n
     }
 
@@ -612,23 +611,34 @@ impl Fixture {
     }
 
     /// The IK working branch of every point of `pts`, each alone, in runs of RUN_ROWS through
-    /// `module_ik::solve_working_each` (as `verne ik` does: LANES points side by side, into
-    /// lists reused from run to run); `each` sees every row's answer. Returns (rows,
-    /// rows `module_ik::working_lanes` answered).
+    /// `module_ik::solve_working_each` (as `verne ik` does); `each` sees every row's answer.
     fn run_ik_lanes(
         &self,
         pts: &[Vector3<f64>],
+        each: impl FnMut(&Vector3<f64>, &module_ik::IkBranches),
+    ) {
+        self.run_ik_runs(pts, |m, rows| module_ik::solve_working_each(m, rows), each);
+    }
+
+    /// `solve` (LANES points side by side) on `pts` in runs of RUN_ROWS, into lists reused
+    /// from run to run as the streaming engine keeps its own; `each` sees every row's answer.
+    fn run_ik_runs(
+        &self,
+        pts: &[Vector3<f64>],
+        solve: impl for<'a> Fn(
+            &Machine,
+            &mut dyn Iterator<Item = (Vector3<f64>, &'a mut module_ik::IkBranches)>,
+        ),
         mut each: impl FnMut(&Vector3<f64>, &module_ik::IkBranches),
-    ) -> usize {
+    ) {
         let mut slots = self.ik_slots.lock().expect("one benchmark at a time");
         for run in pts.chunks(RUN_ROWS) {
-            let rows = run.iter().map(|p| *black_box(p)).zip(slots.iter_mut());
-            module_ik::solve_working_each(&self.machine, rows);
+            let mut rows = run.iter().map(|p| *black_box(p)).zip(slots.iter_mut());
+            solve(&self.machine, &mut rows);
             for (p, b) in run.iter().zip(slots.iter()) {
                 each(p, b);
             }
         }
-        pts.len()
     }
 
     /// Every branch of every tool pose of the machine path, over both orientation solutions of
@@ -763,8 +773,8 @@ impl Fixture {
                 .sum();
             lines.push(format!(
                 "module_ik::solve_working_each on {label}: {} rows, {by_lanes} answered by \
-                 module_ik::working_lanes ({} side by side), the others by \
-                 module_ik::solve_working_into; vs module_ik::working(module_ik::solve): \
+                 module_ik::working_lanes ({} side by side), the others by the cubic or \
+                 module_ik::solve_into; vs module_ik::working(module_ik::solve): \
                  max |d rho| {dr:.1e} mm, max |d alpha| {da:.1e} rad, {mismatch} mismatched rows",
                 pts.len(),
                 module_ik::LANES,

@@ -610,14 +610,19 @@ pub(crate) const FAST_MARGIN_RAD: f64 = 1e-6;
 /// lower roots of (12)-(13). Every step is the one [`solve`] takes for that branch; the margins
 /// send every near-tie of a sign, a square root, alpha = 0 or two candidates to [`solve`].
 pub fn working_fast(m: &Machine, p: &Vector3<f64>) -> Option<IkBranch> {
+    match working_lanes(m, &[*p]) {
+        [Some(branch)] => Some(branch),
+        _ => working_by_cubic(m, p),
+    }
+}
+
+/// The second half of [`working_fast`], for a point [`working_lanes`] was not sure of: the roots
+/// of the cubic (9) above r1/R1, each polished, with the same margins.
+fn working_by_cubic(m: &Machine, p: &Vector3<f64>) -> Option<IkBranch> {
     let g = &m.module;
     if !p.iter().all(|v| v.is_finite()) {
         return None;
     }
-    if let [Some(branch)] = working_lanes(m, &[*p]) {
-        return Some(branch);
-    }
-    // Not sure: the roots of the cubic above r1/R1, each polished.
     let coeffs = cubic_eq9(g, p)?;
     let (r, rr) = (g.r_big1, g.r_small1);
     let lo = (rr / r - FAST_MARGIN_RAD).max(-1.0);
@@ -861,7 +866,17 @@ fn estimated_start(g: &ModuleGeometry, p: &Vector3<f64>) -> (Leg1, bool) {
 /// What `verne ik` needs for one point: the working branch alone when [`working_fast`] is sure
 /// of it, every branch otherwise; [`working`] of the result is the working branch either way.
 pub fn solve_working_into(m: &Machine, p: &Vector3<f64>, out: &mut IkBranches) {
-    match working_fast(m, p) {
+    working_or_all_into(m, p, working_fast(m, p), out);
+}
+
+/// `working` alone into `out` when there is one, else every branch of `p` ([`solve_into`]).
+fn working_or_all_into(
+    m: &Machine,
+    p: &Vector3<f64>,
+    working: Option<IkBranch>,
+    out: &mut IkBranches,
+) {
+    match working {
         Some(b) => {
             out.clear();
             out.push(b);
@@ -882,13 +897,9 @@ pub fn solve_working_each<'a>(
         |pts, outs| {
             let found = working_lanes(m, pts);
             for (k, out) in outs.enumerate() {
-                match found[k] {
-                    Some(b) => {
-                        out.clear();
-                        out.push(b);
-                    }
-                    None => solve_working_into(m, &pts[k], out),
-                }
+                // Where the lanes were not sure, the cubic (not the lanes again).
+                let working = found[k].or_else(|| working_by_cubic(m, &pts[k]));
+                working_or_all_into(m, &pts[k], working, out);
             }
         },
         |p, out| solve_working_into(m, p, out),
