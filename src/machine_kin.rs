@@ -21,11 +21,12 @@
 //!
 //! u = xp + D1 - d1, K1 = L1^2 - R1^2 - r1^2 + 2 R1 r1 cos alpha: a trigonometric polynomial of
 //! degree 3 in theta1, i.e. the paper's degree-6 polynomial in tan(theta1/2). Its real roots are
-//! isolated in two half-angle charts (so theta1 = pi is an ordinary root) by the derivative
-//! recursion of `poly::roots_in`, which cannot miss a simple root. Each root is polished by
-//! Newton on the unsquared leg-I pair (eqs. (10) and (14) of IFToMM 2007) in (theta1, rho1); where
-//! sin(alpha) ~ 0 (there F has a double root, one per sign of rho1 - zp, Table II of IFToMM
-//! 2007) both signs are tried. rho2 and rho3 follow from eqs. (12)-(13), both signs each.
+//! isolated directly on the circle by [`Trig::roots_sin_cos`] (the forward kinematics' method:
+//! complete by construction, no half-angle chart, so theta1 = pi is an ordinary root). Each root
+//! is polished by Newton on the unsquared leg-I pair (eqs. (10) and (14) of IFToMM 2007) in
+//! (theta1, rho1), its sine and cosine carried along the steps; where sin(alpha) ~ 0 (there F has
+//! a double root, one per sign of rho1 - zp, Table II of IFToMM 2007) both signs are tried. rho2
+//! and rho3 follow from eqs. (12)-(13), both signs each.
 
 use std::f64::consts::PI;
 
@@ -39,12 +40,11 @@ use crate::module_ik::{leg_sliders, wrap_angle};
 use crate::orientation::{
     AxisAngles, AxisError, ToolAngles, ToolOrientation, axis_angles, phi1_at, unit_axis,
 };
-use crate::poly::roots_in;
 use crate::tolerance::{
     ACCEPT_RESIDUAL_MM, LIMIT_SLACK, NEWTON_MAX_ITER, NEWTON_STEP_STOP, SAME_SOLUTION_MM,
     SAME_SOLUTION_RAD,
 };
-use crate::trig::Trig;
+use crate::trig::{MAX_TRIG_ROOTS, Trig, TrigRoot, sin_cos_after_step};
 
 /// |sin(alpha)| (dimensionless) below which both signs of rho1 - zp are tried at a root of F:
 /// there F has a double root or two very close ones and the sign from eq. (14) is unreliable.
@@ -209,9 +209,9 @@ fn tilt_frame_platform(table: &TableGeometry, pose: &ToolPose, tool_length: f64)
     Vector3::new(q.x, -q.y, table.d_t - q.z)
 }
 
-/// P(theta1) = trans(z, d_a) rot(x, theta1) w, and its derivative in theta1.
-fn platform_at(d_a: f64, w: &Vector3<f64>, theta1: f64) -> (Vector3<f64>, Vector3<f64>) {
-    let (s, c) = theta1.sin_cos();
+/// P(theta1) = trans(z, d_a) rot(x, theta1) w, and its derivative in theta1, from
+/// (s, c) = sin, cos of theta1.
+fn platform_at(d_a: f64, w: &Vector3<f64>, s: f64, c: f64) -> (Vector3<f64>, Vector3<f64>) {
     let y = c * w.y - s * w.z;
     let z = s * w.y + c * w.z;
     (Vector3::new(w.x, y, d_a + z), Vector3::new(0.0, -z, y))
@@ -239,26 +239,14 @@ pub fn theta1_equation(m: &Machine, pose: &ToolPose, tool_length: f64) -> Trig {
         .add(&yp.mul(&yp).mul(&n1))
 }
 
-/// Real roots theta1 of F (both half-angle charts), each with its "touching" flag.
-fn theta1_roots(f: &Trig) -> ArrayVec<(f64, bool), 32> {
-    let mut out = ArrayVec::new();
-    for shift in [false, true] {
-        let mut poly = f.to_half_angle_poly(shift);
-        let scale = poly.iter().fold(0.0f64, |acc, a| acc.max(a.abs()));
-        if scale == 0.0 || !scale.is_finite() {
-            return out;
-        }
-        for a in poly.iter_mut() {
-            *a /= scale;
-        }
-        for root in &roots_in(&poly, -1.0, 1.0) {
-            let th = 2.0 * root.x.atan() + if shift { PI } else { 0.0 };
-            if !out.is_full() {
-                out.push((wrap_angle(th), root.touching));
-            }
-        }
-    }
-    out
+/// A tilting-axis angle with its sine and cosine (carried along Newton's steps, so that the
+/// polish needs no `sin_cos` per step), and the slider-1 position that goes with it.
+#[derive(Debug, Clone, Copy)]
+struct PathPoint {
+    theta1: f64,
+    sin: f64,
+    cos: f64,
+    rho1: f64,
 }
 
 /// The leg-I equations along the path: g1 = u^2 + yp^2 + (zp - rho1)^2 - K1 (eq. (10), IFToMM
@@ -267,17 +255,26 @@ fn theta1_roots(f: &Trig) -> ArrayVec<(f64, bool), 32> {
 struct Leg1Path<'a> {
     m: &'a Machine,
     w: Vector3<f64>,
-    phi1: f64,
+    sin_phi1: f64,
+    cos_phi1: f64,
 }
 
 impl Leg1Path<'_> {
-    fn eval(&self, theta1: f64, rho1: f64) -> (Vector2<f64>, Matrix2<f64>) {
+    /// sin and cos of alpha = theta1 + phi1 (eq. (14), AIM 2007) by the angle-sum formulas.
+    fn alpha_sin_cos(&self, q: &PathPoint) -> (f64, f64) {
+        (
+            q.sin * self.cos_phi1 + q.cos * self.sin_phi1,
+            q.cos * self.cos_phi1 - q.sin * self.sin_phi1,
+        )
+    }
+
+    fn eval(&self, q: &PathPoint) -> (Vector2<f64>, Matrix2<f64>) {
         let g = &self.m.module;
         let (r, rr) = (g.r_big1, g.r_small1);
-        let (p, dp) = platform_at(self.m.table.d_a, &self.w, theta1);
-        let (sa, ca) = (theta1 + self.phi1).sin_cos();
+        let (p, dp) = platform_at(self.m.table.d_a, &self.w, q.sin, q.cos);
+        let (sa, ca) = self.alpha_sin_cos(q);
         let u = p.x + g.dx1;
-        let dz = p.z - rho1;
+        let dz = p.z - q.rho1;
         let k1 = g.l1 * g.l1 - r * r - rr * rr + 2.0 * r * rr * ca;
         let f = Vector2::new(
             u * u + p.y * p.y + dz * dz - k1,
@@ -292,32 +289,39 @@ impl Leg1Path<'_> {
         (f, j)
     }
 
-    /// Newton from (theta1, rho1); returns the best iterate (smallest residual).
-    fn polish(&self, theta1: f64, rho1: f64) -> (f64, f64) {
-        let mut cur = (theta1, rho1);
-        let mut best = cur;
-        let mut best_f = self.eval(cur.0, cur.1).0.amax();
+    /// Newton from `start`: the best iterate (smallest residual), theta1 wrapped to (-pi, pi],
+    /// with its residuals (g1, g2).
+    fn polish(&self, start: PathPoint) -> (PathPoint, Vector2<f64>) {
+        let mut cur = start;
+        let (mut f, mut j) = self.eval(&cur);
+        let mut best = (cur, f);
         for _ in 0..NEWTON_MAX_ITER {
-            let (f, j) = self.eval(cur.0, cur.1);
             let Some(step) = j.try_inverse().map(|inv| inv * f) else {
                 break;
             };
             if !step.iter().all(|v| v.is_finite()) {
                 break;
             }
-            cur = (cur.0 - step.x, cur.1 - step.y);
-            let fa = self.eval(cur.0, cur.1).0.amax();
-            if fa <= best_f {
-                best = cur;
-                best_f = fa;
+            let theta1 = cur.theta1 - step.x;
+            let (sin, cos) = sin_cos_after_step(cur.sin, cur.cos, theta1, step.x);
+            cur = PathPoint {
+                theta1,
+                sin,
+                cos,
+                rho1: cur.rho1 - step.y,
+            };
+            (f, j) = self.eval(&cur);
+            if f.amax() <= best.1.amax() {
+                best = (cur, f);
             }
             if step.x.abs() < NEWTON_STEP_STOP
-                && step.y.abs() < NEWTON_STEP_STOP * (1.0 + cur.1.abs())
+                && step.y.abs() < NEWTON_STEP_STOP * (1.0 + cur.rho1.abs())
             {
                 break;
             }
         }
-        (wrap_angle(best.0), best.1)
+        best.0.theta1 = wrap_angle(best.0.theta1);
+        best
     }
 }
 
@@ -340,30 +344,42 @@ pub fn machine_ik(m: &Machine, pose: &ToolPose, tool_length: f64) -> MachineIkBr
     }
     let g = &m.module;
     let (r, rr) = (g.r_big1, g.r_small1);
-    let w = tilt_frame_platform(&m.table, pose, tool_length);
+    let (sin_phi1, cos_phi1) = pose.phi1.sin_cos();
     let path = Leg1Path {
         m,
-        w,
-        phi1: pose.phi1,
+        w: tilt_frame_platform(&m.table, pose, tool_length),
+        sin_phi1,
+        cos_phi1,
     };
     let f = theta1_equation(m, pose, tool_length);
-    // Seeds: the roots of F, plus the two values where sin(alpha) = 0 (F's double roots).
-    let mut seeds = theta1_roots(&f);
+    // Seeds: the roots of F on the circle, plus the two values where sin(alpha) = 0, F's double
+    // roots (flagged: both signs of rho1 - zp there, Table II of IFToMM 2007). Elsewhere the sign
+    // comes from eq. (14), even at a double root of F (a tangency, where it is still defined).
+    let mut seeds: ArrayVec<(TrigRoot, bool), { MAX_TRIG_ROOTS + 2 }> = f
+        .roots_sin_cos()
+        .into_iter()
+        .map(|root| (root, false))
+        .collect();
     for th in [-pose.phi1, PI - pose.phi1] {
-        if !seeds.is_full() {
-            seeds.push((wrap_angle(th), true));
-        }
+        let (sin, cos) = th.sin_cos();
+        seeds.push((TrigRoot { x: th, sin, cos }, true));
     }
-    let mut pairs: ArrayVec<(f64, f64), MAX_THETA1_SOLUTIONS> = ArrayVec::new();
-    for (th, touching) in seeds {
-        let (p, _) = platform_at(m.table.d_a, &w, th);
-        let (sa, ca) = (th + pose.phi1).sin_cos();
+    let mut pairs: ArrayVec<PathPoint, MAX_THETA1_SOLUTIONS> = ArrayVec::new();
+    for (root, at_alpha_zero) in seeds {
+        let seed = |rho1: f64| PathPoint {
+            theta1: root.x,
+            sin: root.sin,
+            cos: root.cos,
+            rho1,
+        };
+        let (p, _) = platform_at(m.table.d_a, &path.w, root.sin, root.cos);
+        let (sa, ca) = path.alpha_sin_cos(&seed(0.0));
         let u = p.x + g.dx1;
         let k1 = g.l1 * g.l1 - r * r - rr * rr + 2.0 * r * rr * ca;
         let h2 = k1 - u * u - p.y * p.y;
         let h = h2.max(0.0).sqrt();
         let mut starts: ArrayVec<f64, 2> = ArrayVec::new();
-        if touching || sa.abs() < BOTH_SIGNS_SIN_ALPHA {
+        if at_alpha_zero || sa.abs() < BOTH_SIGNS_SIN_ALPHA {
             starts.push(p.z + h);
             starts.push(p.z - h);
         } else {
@@ -371,27 +387,27 @@ pub fn machine_ik(m: &Machine, pose: &ToolPose, tool_length: f64) -> MachineIkBr
             starts.push(p.z + p.y * (r * ca - rr) / (r * sa));
         }
         for rho1 in starts {
-            let (th1, rho1) = path.polish(th, rho1);
-            let (fv, _) = path.eval(th1, rho1);
+            let (q, fv) = path.polish(seed(rho1));
             // Residuals of (10) and (14) as lengths along the rod (mm).
             let res = (fv.x / (2.0 * g.l1)).abs().max((fv.y / r).abs());
             if res.is_nan() || res > ACCEPT_RESIDUAL_MM {
                 continue;
             }
-            let dup = pairs.iter().any(|&(t, q)| {
-                wrap_angle(t - th1).abs() < SAME_SOLUTION_RAD
-                    && (q - rho1).abs() < SAME_SOLUTION_MM * (1.0 + rho1.abs())
+            let dup = pairs.iter().any(|o| {
+                wrap_angle(o.theta1 - q.theta1).abs() < SAME_SOLUTION_RAD
+                    && (o.rho1 - q.rho1).abs() < SAME_SOLUTION_MM * (1.0 + q.rho1.abs())
             });
             if !dup && !pairs.is_full() {
-                pairs.push((th1, rho1));
+                pairs.push(q);
             }
         }
     }
     let theta2 = wrap_angle(-pose.phi2);
-    for (theta1, rho1) in pairs {
-        let (p, _) = platform_at(m.table.d_a, &w, theta1);
+    for q in pairs {
+        let (theta1, rho1) = (q.theta1, q.rho1);
+        let (p, _) = platform_at(m.table.d_a, &path.w, q.sin, q.cos);
         let alpha = wrap_angle(theta1 + pose.phi1);
-        let (sa, ca) = alpha.sin_cos();
+        let (sa, ca) = path.alpha_sin_cos(&q);
         let dx2 = p.x + g.dx2;
         // eq. (12): rho2 = zp - R2 sin a + s2 sqrt(L2^2 - (xp + D2 - d2)^2 - (yp - R2 cos a + r4)^2)
         let Some(r2) = leg_sliders(g.l2, dx2, p.y - g.r_big2 * ca + g.r4, p.z - g.r_big2 * sa)
