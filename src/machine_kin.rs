@@ -33,10 +33,10 @@ use std::f64::consts::PI;
 use arrayvec::ArrayVec;
 use nalgebra::{Matrix2, Matrix4, Vector2, Vector3, Vector4};
 
-use crate::branches::{Config, Reason, Verdict, label};
+use crate::branches::{Config, Reason, Verdict, cos_tilt_max, leg_state};
 use crate::machine::{Machine, TableGeometry};
-use crate::module_geometry::{ModulePose, Sliders, residual_mm};
-use crate::module_ik::{leg_sliders, wrap_angle};
+use crate::module_geometry::{ModulePose, Sliders, residual_mm_sc};
+use crate::module_ik::{Leg1, posture_branches, wrap_angle};
 use crate::orientation::{
     AxisAngles, AxisError, ToolAngles, ToolOrientation, axis_angles, phi1_at, unit_axis,
 };
@@ -403,44 +403,43 @@ pub fn machine_ik(m: &Machine, pose: &ToolPose, tool_length: f64) -> MachineIkBr
         }
     }
     let theta2 = wrap_angle(-pose.phi2);
+    let cos_tilt = cos_tilt_max(m);
     for q in pairs {
-        let (theta1, rho1) = (q.theta1, q.rho1);
         let (p, _) = platform_at(m.table.d_a, &path.w, q.sin, q.cos);
-        let alpha = wrap_angle(theta1 + pose.phi1);
-        let (sa, ca) = path.alpha_sin_cos(&q);
-        let dx2 = p.x + g.dx2;
-        // eq. (12): rho2 = zp - R2 sin a + s2 sqrt(L2^2 - (xp + D2 - d2)^2 - (yp - R2 cos a + r4)^2)
-        let Some(r2) = leg_sliders(g.l2, dx2, p.y - g.r_big2 * ca + g.r4, p.z - g.r_big2 * sa)
-        else {
+        let (sin, cos) = path.alpha_sin_cos(&q);
+        let leg1 = Leg1 {
+            alpha: wrap_angle(q.theta1 + pose.phi1),
+            rho1: q.rho1,
+            sin,
+            cos,
+        };
+        // The module's four branches on this posture: legs II and III by eqs. (12)-(13).
+        let l1 = leg_state(m, 0, &p, sin, cos, q.rho1, cos_tilt).check();
+        let Some(four) = posture_branches(m, &p, &leg1, l1, cos_tilt) else {
             continue;
         };
-        // eq. (13): rho3 = zp + R2 sin a + s3 sqrt(L3^2 - (xp + D2 - d2)^2 - (yp + R2 cos a - r4)^2)
-        let Some(r3) = leg_sliders(g.l3, dx2, p.y + g.r_big2 * ca - g.r4, p.z + g.r_big2 * sa)
-        else {
-            continue;
+        let mut table = Verdict::default();
+        if !theta1_in_limits(m, q.theta1) {
+            table.add(Reason::Theta1Range);
+        }
+        let module = ModulePose {
+            p,
+            alpha: leg1.alpha,
         };
-        let module = ModulePose { p, alpha };
-        for rho2 in r2 {
-            for rho3 in r3 {
-                let rho = Sliders::new(rho1, rho2, rho3);
-                if residual_mm(g, &module, &rho) > ACCEPT_RESIDUAL_MM {
-                    continue;
-                }
-                let (config, mut verdict) = label(m, &p, sa, ca, &rho);
-                if !theta1_in_limits(m, theta1) {
-                    verdict.add(Reason::Theta1Range);
-                }
-                if !out.is_full() {
-                    out.push(MachineIkBranch {
-                        rho,
-                        theta1,
-                        theta2,
-                        alpha,
-                        platform: p,
-                        config,
-                        verdict,
-                    });
-                }
+        for b in four {
+            if residual_mm_sc(g, &module, &b.rho, sin, cos) > ACCEPT_RESIDUAL_MM {
+                continue;
+            }
+            if !out.is_full() {
+                out.push(MachineIkBranch {
+                    rho: b.rho,
+                    theta1: q.theta1,
+                    theta2,
+                    alpha: leg1.alpha,
+                    platform: p,
+                    config: b.config,
+                    verdict: b.verdict.with(table),
+                });
             }
         }
     }

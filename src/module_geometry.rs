@@ -66,9 +66,18 @@ pub fn residuals(g: &ModuleGeometry, pose: &ModulePose, rho: &Sliders) -> Vector
 
 /// The largest residual expressed as a length error along its rod, |f| / (2 L) (mm).
 pub fn residual_mm(g: &ModuleGeometry, pose: &ModulePose, rho: &Sliders) -> f64 {
-    let r = residuals(g, pose, rho);
+    let (s, c) = pose.alpha.sin_cos();
+    residual_mm_sc(g, pose, rho, s, c)
+}
+
+/// [`residual_mm`] with (sin alpha, cos alpha) given.
+#[inline]
+pub fn residual_mm_sc(g: &ModuleGeometry, pose: &ModulePose, rho: &Sliders, s: f64, c: f64) -> f64 {
+    let v = rod_vectors_sc(g, pose, rho, s, c);
     let l = rod_lengths(g);
-    (0..4).fold(0.0f64, |m, i| m.max((r[i] / (2.0 * l[i])).abs()))
+    (0..4).fold(0.0f64, |m, i| {
+        m.max(((v[i].norm_squared() - l[i] * l[i]) / (2.0 * l[i])).abs())
+    })
 }
 
 /// Derivatives of each rod vector with respect to alpha.

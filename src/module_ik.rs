@@ -447,11 +447,6 @@ pub(crate) fn leg_root(l: f64, dx: f64, dy: f64) -> Option<f64> {
     Some(arg.max(0.0).sqrt())
 }
 
-/// Both roots of eqs. (12)-(13) for one leg: `offset + s * sqrt(L^2 - dx^2 - dy^2)`, s = -1 first.
-pub(crate) fn leg_sliders(l: f64, dx: f64, dy: f64, offset: f64) -> Option<[f64; 2]> {
-    leg_root(l, dx, dy).map(|h| [offset - h, offset + h])
-}
-
 /// Every real inverse-kinematics branch of the parallel module for point `p`, ordered by alpha
 /// then by (s1, s2, s3), each with its configuration and verdict. Empty when unreachable.
 pub fn solve(m: &Machine, p: &Vector3<f64>) -> IkBranches {
@@ -526,7 +521,6 @@ fn in_lanes<'a>(
 /// Every branch on the leg-I postures `legs1` of `p` into `out` (cleared first), ordered and
 /// labelled as [`solve`] gives them.
 fn branches_into(m: &Machine, p: &Vector3<f64>, legs1: &ArrayVec<Leg1, 6>, out: &mut IkBranches) {
-    let g = &m.module;
     out.clear();
     if !p.iter().all(|v| v.is_finite()) {
         return;
@@ -561,39 +555,50 @@ fn branches_into(m: &Machine, p: &Vector3<f64>, legs1: &ArrayVec<Leg1, 6>, out: 
         order[..n].sort_unstable_by(|&a, &b| before(a, b));
     }
     for &k in &order[..n] {
-        let (leg1, l1) = (legs1[k], checks[k]);
-        let (s, c) = (leg1.sin, leg1.cos);
-        let dx2 = p.x + g.dx2;
-        // eq. (12): rho2 = zp - R2 sin a + s2 sqrt(L2^2 - (xp + D2 - d2)^2 - (yp - R2 cos a + r4)^2)
-        let (dy2, off2) = (p.y - g.r_big2 * c + g.r4, p.z - g.r_big2 * s);
-        let Some(h2) = leg_root(g.l2, dx2, dy2) else {
-            continue;
-        };
-        // eq. (13): rho3 = zp + R2 sin a + s3 sqrt(L3^2 - (xp + D2 - d2)^2 - (yp + R2 cos a - r4)^2)
-        let (dy3, off3) = (p.y + g.r_big2 * c - g.r4, p.z + g.r_big2 * s);
-        let Some(h3) = leg_root(g.l3, dx2, dy3) else {
-            continue;
-        };
-        let (r2, r3) = ([off2 - h2, off2 + h2], [off3 - h3, off3 + h3]);
-        // Labels and verdicts leg by leg: leg I once per posture, legs II and III once per pair
-        // of roots.
-        let [l2a, l2b] = outer_leg_states(m, 1, (dx2, dy2, h2), r2, cos_tilt);
-        let [l3a, l3b] = outer_leg_states(m, 2, (dx2, dy3, h3), r3, cos_tilt);
-        let (l2, l3) = ([l2a.check(), l2b.check()], [l3a.check(), l3b.check()]);
-        let v1 = l1.1.with(rods_cross(m, c));
-        let branch = |k2: usize, k3: usize| IkBranch {
-            alpha: leg1.alpha,
-            rho: Sliders::new(leg1.rho1, r2[k2], r3[k3]),
-            config: [l1.0, l2[k2].0, l3[k3].0],
-            verdict: v1.with(l2[k2].1).with(l3[k3].1),
-        };
-        let four = [branch(0, 0), branch(0, 1), branch(1, 0), branch(1, 1)];
-        let pushed = out.try_extend_from_slice(&four);
-        debug_assert!(
-            pushed.is_ok(),
-            "six postures of four branches fit MAX_IK_BRANCHES"
-        );
+        if let Some(four) = posture_branches(m, p, &legs1[k], checks[k], cos_tilt) {
+            let pushed = out.try_extend_from_slice(&four);
+            debug_assert!(
+                pushed.is_ok(),
+                "six postures of four branches fit MAX_IK_BRANCHES"
+            );
+        }
     }
+}
+
+/// The four branches of `p` on the leg-I posture `leg1` (s2, s3 = -1 before +1: the roots of
+/// (12)-(13) in increasing order), labelled; None when leg II or III cannot reach. `l1` is leg
+/// I's label and verdict at the posture, `cos_tilt` [`cos_tilt_max`].
+#[inline(always)]
+pub(crate) fn posture_branches(
+    m: &Machine,
+    p: &Vector3<f64>,
+    leg1: &Leg1,
+    l1: (i8, Verdict),
+    cos_tilt: f64,
+) -> Option<[IkBranch; 4]> {
+    let g = &m.module;
+    let (s, c) = (leg1.sin, leg1.cos);
+    let dx2 = p.x + g.dx2;
+    // eq. (12): rho2 = zp - R2 sin a + s2 sqrt(L2^2 - (xp + D2 - d2)^2 - (yp - R2 cos a + r4)^2)
+    let (dy2, off2) = (p.y - g.r_big2 * c + g.r4, p.z - g.r_big2 * s);
+    let h2 = leg_root(g.l2, dx2, dy2)?;
+    // eq. (13): rho3 = zp + R2 sin a + s3 sqrt(L3^2 - (xp + D2 - d2)^2 - (yp + R2 cos a - r4)^2)
+    let (dy3, off3) = (p.y + g.r_big2 * c - g.r4, p.z + g.r_big2 * s);
+    let h3 = leg_root(g.l3, dx2, dy3)?;
+    let (r2, r3) = ([off2 - h2, off2 + h2], [off3 - h3, off3 + h3]);
+    // Labels and verdicts leg by leg: leg I once per posture, legs II and III once per pair of
+    // roots.
+    let [l2a, l2b] = outer_leg_states(m, 1, (dx2, dy2, h2), r2, cos_tilt);
+    let [l3a, l3b] = outer_leg_states(m, 2, (dx2, dy3, h3), r3, cos_tilt);
+    let (l2, l3) = ([l2a.check(), l2b.check()], [l3a.check(), l3b.check()]);
+    let v1 = l1.1.with(rods_cross(m, c));
+    let branch = |k2: usize, k3: usize| IkBranch {
+        alpha: leg1.alpha,
+        rho: Sliders::new(leg1.rho1, r2[k2], r3[k3]),
+        config: [l1.0, l2[k2].0, l3[k3].0],
+        verdict: v1.with(l2[k2].1).with(l3[k3].1),
+    };
+    Some([branch(0, 0), branch(0, 1), branch(1, 0), branch(1, 1)])
 }
 
 /// How far (mm) a configuration sign or a square root must be from zero, and (rad) two candidate
