@@ -170,7 +170,7 @@ fn leg1_postures_into(
             g,
             p,
             Leg1 {
-                alpha: c.acos(),
+                alpha: libm::acos(c),
                 rho1,
                 sin: sin_a,
                 cos: c,
