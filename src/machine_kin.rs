@@ -233,10 +233,11 @@ pub fn theta1_equation(m: &Machine, pose: &ToolPose, tool_length: f64) -> Trig {
     // u^2 - K1 and R1^2 + r1^2 - 2 R1 r1 cos(alpha).
     let u2_k1 = Trig::linear(u * u - k0, 0.0, 0.0).add(&ca.scale(-2.0 * r * rr));
     let n1 = Trig::linear(r * r + rr * rr, 0.0, 0.0).add(&ca.scale(-2.0 * r * rr));
-    sa.mul(&sa)
-        .mul(&u2_k1)
+    // Degrees 1 + 1 + 1 and 1 + 1 + 1 (loops fixed at compile time).
+    sa.mul_deg::<1, 1>(&sa)
+        .mul_deg::<2, 1>(&u2_k1)
         .scale(r * r)
-        .add(&yp.mul(&yp).mul(&n1))
+        .add(&yp.mul_deg::<1, 1>(&yp).mul_deg::<2, 1>(&n1))
 }
 
 /// A tilting-axis angle with its sine and cosine (carried along Newton's steps, so that the

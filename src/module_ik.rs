@@ -421,12 +421,21 @@ fn with_wrapped_alpha(mut l: Leg1) -> Leg1 {
 /// Angle in (-pi, pi].
 #[inline]
 pub fn wrap_angle(a: f64) -> f64 {
-    if a > -std::f64::consts::PI && a <= std::f64::consts::PI {
+    use std::f64::consts::PI;
+    let tau = std::f64::consts::TAU;
+    if a > -PI && a <= PI {
         return a;
     }
-    let tau = std::f64::consts::TAU;
+    // One turn out (sums and differences of wrapped angles): a -/+ 2 pi is exact there (Sterbenz)
+    // and equals the remainder below (but -2 pi gives +0, not -0), without its division loop.
+    if a > PI && a <= 3.0 * PI {
+        return a - tau;
+    }
+    if a <= -PI && a > -3.0 * PI {
+        return a + tau;
+    }
     let mut w = a.rem_euclid(tau);
-    if w > std::f64::consts::PI {
+    if w > PI {
         w -= tau;
     }
     w
@@ -964,4 +973,44 @@ pub(crate) fn isolated_working_root(m: &Machine, p: &Vector3<f64>) -> bool {
         & (!vertex_inside | (3.0 * c3 * c1 - c2 * c2 > 3.0 * c3 * margin));
     // Without a branch (for working_lanes); a NaN fails every comparison.
     (c3 > margin) & margin.is_finite() & (decreasing | increasing)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::wrap_angle;
+    use std::f64::consts::{PI, TAU};
+
+    /// The remainder formula the one-turn shortcut of [`wrap_angle`] replaces.
+    fn by_remainder(a: f64) -> f64 {
+        let w = a.rem_euclid(TAU);
+        if w > PI { w - TAU } else { w }
+    }
+
+    /// Within one turn out, the shortcut gives the remainder's result exactly (a zero result
+    /// always +0); ends and far angles included.
+    #[test]
+    fn wrap_angle_one_turn_out_is_the_remainder() {
+        let mut s = 0x9e37_79b9_7f4a_7c15u64;
+        let mut unit = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut angles = vec![PI, -PI, 3.0 * PI, -3.0 * PI, TAU, -TAU, 0.0, 1e300, -7.5e3];
+        for k in [PI, 3.0 * PI, TAU] {
+            angles.extend([k.next_up(), k.next_down(), -k.next_up(), -k.next_down()]);
+        }
+        angles.extend((0..200_000).map(|_| (unit() - 0.5) * 7.0 * PI));
+        for a in angles {
+            let w = wrap_angle(a);
+            assert!(w > -PI && w <= PI, "{a} -> {w}");
+            if a.abs() > PI {
+                assert_eq!(w, by_remainder(a), "{a}");
+            }
+            if w == 0.0 {
+                assert!(w.is_sign_positive(), "{a}");
+            }
+        }
+    }
 }
