@@ -4,7 +4,7 @@
 # between the `bench.sh:begin` / `bench.sh:end` markers (the text around them is kept).
 #
 # Usage: scripts/bench.sh [--rows N] [--big] [--runs N] [--no-kernels] [--no-docs]
-#   --rows N      rows of the timing trajectory (default 1000000)
+#   --rows N      rows of the timing trajectory (default 1000000; the tool-pose path has N / 10)
 #   --big         also run the 10,000,000-row memory check (peak RSS of verne ik and fk)
 #   --runs N      timed runs per command (default 5)
 #   --no-kernels  skip `cargo bench --bench kernels`
@@ -71,7 +71,28 @@ gen_path() { # rows file
     }' > "$2"
 }
 
+# The CAM job's input: tool poses (tip + axis in the workpiece frame) on the kernels' dome spiral
+# (benches/kernels.rs: centre (0, 0, -100), radius 150 mm, tool tilted 6 to 30 deg along the
+# normal, tips 0.5 mm apart), tips with 4 decimals and axes with 7.
+gen_tool_path() { # rows file
+    awk -v n="$1" 'BEGIN {
+        print "x,y,z,i,j,k"; pi = 3.141592653589793; r = 150; step = 0.5
+        b0 = 6 * pi / 180; b1 = 30 * pi / 180
+        turns = n * step / (2 * pi * r * (cos(b0) - cos(b1)) / (b1 - b0))
+        db = (b1 - b0) / (2 * pi * turns); psi = 0
+        for (i = 0; i < n; i++) {
+            beta = b0 + db * psi
+            nx = sin(beta) * cos(psi); ny = sin(beta) * sin(psi); nz = cos(beta)
+            printf "%.4f,%.4f,%.4f,%.7f,%.7f,%.7f\n", r * nx, r * ny, -100 + r * nz, nx, ny, nz
+            psi += step / (r * sqrt(sin(beta) ^ 2 + db ^ 2))
+        }
+    }' > "$2"
+}
+
 PATH_CSV="$WORK/path_$ROWS.csv"
+TOOL_ROWS=$((ROWS / 10))
+TOOL_CSV="$WORK/tool_path_$TOOL_ROWS.csv"
+[ -s "$TOOL_CSV" ] || { log "generating $TOOL_CSV"; gen_tool_path "$TOOL_ROWS" "$TOOL_CSV"; }
 JOINTS_CSV="$WORK/joints_$ROWS.csv"
 [ -s "$PATH_CSV" ] || { log "generating $PATH_CSV"; gen_path "$ROWS" "$PATH_CSV"; }
 log "verne ik -> $JOINTS_CSV (the fk input)"
@@ -121,6 +142,8 @@ run_case floor_ik "$FLOOR" ik "$PATH_CSV" -o "$OUT"
 run_case fk "$VERNE" fk "$JOINTS_CSV" -o "$OUT"
 run_case fk1 env RAYON_NUM_THREADS=1 "$VERNE" fk "$JOINTS_CSV" -o "$OUT"
 run_case floor_fk "$FLOOR" fk "$JOINTS_CSV" -o "$OUT"
+run_case tool "$VERNE" ik "$TOOL_CSV" -o "$OUT"
+run_case tool1 env RAYON_NUM_THREADS=1 "$VERNE" ik "$TOOL_CSV" -o "$OUT"
 rm -f "$OUT"
 
 BIG_IK=""; BIG_FK=""
@@ -145,7 +168,7 @@ if [ "$KERNELS" = 1 ]; then
 fi
 
 # ------------------------------------------------------------------------------- report
-rate() { awk -v n="$ROWS" -v t="$1" 'BEGIN { printf "%.2f M", n / t / 1e6 }'; }
+rate() { awk -v n="${2:-$ROWS}" -v t="$1" 'BEGIN { printf "%.2f M", n / t / 1e6 }'; }
 ratio() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.2f", a / b }'; }
 cpu() { awk -v u="$1" -v s="$2" 'BEGIN { printf "%.3f", u + s }'; }
 line() { # key floor-key label
@@ -173,6 +196,17 @@ REPORT="$WORK/report.md"
     line fk floor_fk "\`verne fk\` (on the ik output)"
     line fk1 floor_fk "\`verne fk\`, RAYON_NUM_THREADS=1"
     line floor_fk floor_fk "\`io_floor fk\`"
+    echo
+    echo "The CAM job, $TOOL_ROWS tool poses (\`$TOOL_CSV\`, dome spiral, tip + axis; every row solves both orientation solutions and follows one branch; no I/O floor target):"
+    echo
+    echo "| command | wall s | CPU s | rows/s (wall) | us per row (CPU) | peak RSS MiB |"
+    echo "|---|---:|---:|---:|---:|---:|"
+    for k in tool tool1; do
+        label="\`verne ik\`"; [ "$k" = tool1 ] && label="$label, RAYON_NUM_THREADS=1"
+        printf '| %s | %.3f | %s | %s | %s | %s |\n' "$label" "${T[$k]}" "$(cpu "${U[$k]}" "${S[$k]}")" \
+            "$(rate "${T[$k]}" "$TOOL_ROWS")" \
+            "$(awk -v c="$(cpu "${U[$k]}" "${S[$k]}")" -v n="$TOOL_ROWS" 'BEGIN { printf "%.1f", c / n * 1e6 }')" "${R[$k]}"
+    done
     if [ -n "$BIG_IK" ]; then
         echo
         echo "Memory check, $BIG_ROWS rows: peak RSS \`verne ik\` $BIG_IK MiB, \`verne fk\` $BIG_FK MiB (target < 32 MB)."
@@ -189,6 +223,8 @@ REPORT="$WORK/report.md"
     echo "$VERNE fk $JOINTS_CSV -o $OUT"
     echo "RAYON_NUM_THREADS=1 $VERNE fk $JOINTS_CSV -o $OUT"
     echo "$FLOOR fk $JOINTS_CSV -o $OUT"
+    echo "$VERNE ik $TOOL_CSV -o $OUT"
+    echo "RAYON_NUM_THREADS=1 $VERNE ik $TOOL_CSV -o $OUT"
     [ -n "$BIG_IK" ] && echo "/usr/bin/time -v $VERNE ik $WORK/path_$BIG_ROWS.csv -o $WORK/joints_$BIG_ROWS.csv"
     [ -n "$BIG_IK" ] && echo "/usr/bin/time -v $VERNE fk $WORK/joints_$BIG_ROWS.csv > /dev/null"
     [ -n "$KERNEL_TABLE" ] && echo "VERNE_BENCH_SUMMARY=$WORK/kernels.md cargo bench --bench kernels"

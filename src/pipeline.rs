@@ -16,7 +16,11 @@ use crate::table::{CellError, CsvSource, Sink, encode_field, format_number, pars
 pub const BATCH_ROWS: usize = 4096;
 /// Output rows a batch aims at: a job that writes several rows per input row (`--all`) reads
 /// fewer input rows per batch, so memory stays bounded whatever the input.
-const BATCH_OUTPUT_ROWS: usize = 8 * BATCH_ROWS;
+const BATCH_OUTPUT_ROWS: usize = 2 * BATCH_ROWS;
+/// Bytes of pending rows a batch may hold (three batches are in flight): a row keeps its
+/// solver's fixed-capacity result, about 1 KB for the module (every IK branch) and 6 KB for the
+/// machine (every branch of both orientation solutions), so the machine's batches are shorter.
+const BATCH_BYTES: usize = 4 << 20;
 
 /// Most numeric input columns a job reads.
 pub const MAX_INPUTS: usize = 8;
@@ -203,9 +207,15 @@ struct Batch<S> {
 }
 
 impl<S: Default> Batch<S> {
+    /// Most rows a batch of this job reads: [`BATCH_ROWS`], fewer when its rows are large
+    /// ([`BATCH_BYTES`]).
+    fn max_rows() -> usize {
+        (BATCH_BYTES / size_of::<PendingRow<S>>().max(1)).clamp(RUN_ROWS, BATCH_ROWS)
+    }
+
     fn new() -> Batch<S> {
         Batch {
-            rows: Vec::with_capacity(BATCH_ROWS),
+            rows: Vec::with_capacity(Self::max_rows()),
             filled: 0,
             out_input: Vec::new(),
             out_cells: Vec::new(),
@@ -214,7 +224,7 @@ impl<S: Default> Batch<S> {
         }
     }
 
-    /// Reads up to [`BATCH_ROWS`] records, reusing the rows in place (a row holds a solver's
+    /// Reads up to `rows` records, reusing the rows in place (a row holds a solver's
     /// fixed-capacity result, a kilobyte or more: moving rows would cost more than solving).
     fn fill(&mut self, source: &mut CsvSource, rows: usize) -> Result<(), VerneError> {
         self.filled = 0;
@@ -347,7 +357,8 @@ pub fn run<J: RowJob>(
             .len()
             .div_ceil(solving.filled.max(1))
             .max(1);
-        batch_rows = (BATCH_OUTPUT_ROWS / per_input).clamp(RUN_ROWS, BATCH_ROWS);
+        batch_rows =
+            (BATCH_OUTPUT_ROWS / per_input).clamp(RUN_ROWS, Batch::<J::Solved>::max_rows());
         std::mem::swap(&mut solving, &mut writing);
     }
     writing.write(sink)?;
