@@ -37,8 +37,8 @@ use crate::machine::{Machine, ModuleGeometry, TableGeometry};
 use crate::module_geometry::{ModulePose, Sliders};
 use crate::module_ik::{self, IkBranch, wrap_angle};
 use crate::pipeline::{Cell, Units, write_cell};
-use crate::poly::roots_in;
 use crate::tolerance::LIMIT_SLACK;
+use crate::trig::{MAX_TRIG_ROOTS, Trig};
 
 /// Bounds on the velocity amplification factors (constraint (iii)): the comparative study's
 /// 1/3 < lambda_i < 3 (Wenger, Gosselin, Chablat 2001, eq. (4)).
@@ -564,60 +564,30 @@ impl PlatformOfAlpha {
         )
     }
 
-    /// Eq. (15), AIM 2007, at P(alpha), times (1 + t^2)^3 with t = tan(alpha/2): coefficients of
-    /// a polynomial of degree 6 in t, lowest first.
+    /// Eq. (15), AIM 2007, at P(alpha): a trigonometric polynomial of degree 3 in alpha (the
+    /// paper's degree-6 polynomial in tan(alpha/2)),
     ///
-    /// G = R1^2 s^2 u^2 + K yp^2 - R1^2 s^2 (L1^2 - K), K = R1^2 + r1^2 - 2 R1 r1 c,
-    /// u = xp + D1 - d1; with T = 1 + t^2: s T = 2t, K T = (R1 - r1)^2 + (R1 + r1)^2 t^2,
-    /// yp T = (a0 + a_c) + 2 a_s t + (a0 - a_c) t^2.
-    fn coupling_polynomial(&self, g: &ModuleGeometry) -> [f64; 7] {
+    /// G = R1^2 sin^2(alpha) (u^2 - L1^2 + K) + K yp^2, K = R1^2 + r1^2 - 2 R1 r1 cos(alpha),
+    /// u = xp + D1 - d1, yp = a0 + a_s sin(alpha) + a_c cos(alpha).
+    fn coupling_equation(&self, g: &ModuleGeometry) -> Trig {
         let (r, rr, l) = (g.r_big1, g.r_small1, g.l1);
         let u = self.x + g.dx1;
-        let y = [
-            self.a[0] + self.a[2],
-            2.0 * self.a[1],
-            self.a[0] - self.a[2],
-        ];
-        let k = [(r - rr) * (r - rr), 0.0, (r + rr) * (r + rr)];
-        let y2 = mul::<3, 3, 5>(&y, &y);
-        let ky2 = mul::<3, 5, 7>(&k, &y2);
-        let mut out = ky2;
-        let c1 = 4.0 * r * r * u * u;
-        // R1^2 (2t)^2 u^2 T
-        out[2] += c1;
-        out[4] += c1;
-        // -R1^2 (2t)^2 (L1^2 T - K T)
-        let c2 = 4.0 * r * r;
-        out[2] -= c2 * (l * l - k[0]);
-        out[4] -= c2 * (l * l - k[2]);
-        out
+        let k = Trig::linear(r * r + rr * rr, -2.0 * r * rr, 0.0);
+        let yp = Trig::linear(self.a[0], self.a[2], self.a[1]);
+        let sin = Trig::linear(0.0, 0.0, 1.0);
+        sin.mul_deg::<1, 1>(&sin)
+            .mul_deg::<2, 1>(&k.add(&Trig::linear(u * u - l * l, 0.0, 0.0)))
+            .scale(r * r)
+            .add(&k.mul_deg::<1, 2>(&yp.mul_deg::<1, 1>(&yp)))
     }
 }
 
-fn mul<const A: usize, const B: usize, const C: usize>(a: &[f64; A], b: &[f64; B]) -> [f64; C] {
-    let mut out = [0.0; C];
-    for (i, x) in a.iter().enumerate() {
-        for (j, y) in b.iter().enumerate() {
-            out[i + j] += x * y;
-        }
-    }
-    out
-}
-
-/// Every real alpha in (-pi, pi] with G(alpha) = 0, sorted (two charts: t = tan(alpha/2) in
-/// [-1, 1], and 1/t in [-1, 1]).
-fn coupling_roots(c: &[f64; 7]) -> arrayvec::ArrayVec<f64, 24> {
-    let mut out = arrayvec::ArrayVec::<f64, 24>::new();
-    for r in &roots_in(c, -1.0, 1.0) {
-        out.push(2.0 * r.x.atan());
-    }
-    let mut rev = *c;
-    rev.reverse();
-    for r in &roots_in(&rev, -1.0, 1.0) {
-        if r.x != 0.0 && r.x.abs() < 1.0 && !out.is_full() {
-            out.push(wrap_angle(2.0 * (1.0 / r.x).atan()));
-        }
-    }
+/// Every real alpha in (-pi, pi] with G(alpha) = 0, sorted: isolated on the circle by
+/// [`Trig::roots`] (complete by construction; a double root or a pair too close to separate is
+/// one candidate, which the inverse kinematics at P(alpha) then decides).
+fn coupling_roots(g: &Trig) -> arrayvec::ArrayVec<f64, MAX_TRIG_ROOTS> {
+    let mut out: arrayvec::ArrayVec<f64, MAX_TRIG_ROOTS> =
+        g.roots().into_iter().map(wrap_angle).collect();
     out.sort_by(f64::total_cmp);
     out
 }
@@ -700,8 +670,8 @@ pub fn classify(m: &Machine, opts: &WorkspaceOptions, q: &Vector3<f64>) -> Point
         }
         Of::Tool | Of::Manufacturing => {
             let map = PlatformOfAlpha::new(opts.of, &m.table, opts.tool_length, q);
-            let poly = map.coupling_polynomial(&m.module);
-            for alpha in coupling_roots(&poly) {
+            let coupling = map.coupling_equation(&m.module);
+            for alpha in coupling_roots(&coupling) {
                 let p = map.at(alpha);
                 for b in module_ik::solve(m, &p) {
                     if wrap_angle(b.alpha - alpha).abs() < ALPHA_MATCH_RAD {
@@ -1049,7 +1019,7 @@ mod tests {
     }
 
     #[test]
-    fn coupling_polynomial_is_eq_15_times_t_cubed() {
+    fn coupling_equation_is_eq_15() {
         let m = Machine::default_verne();
         let g = m.module;
         let map = PlatformOfAlpha::new(
@@ -1058,8 +1028,8 @@ mod tests {
             70.0,
             &Vector3::new(-200.0, 40.0, 1100.0),
         );
-        let c = map.coupling_polynomial(&g);
-        for alpha in [-2.5, -0.7, -0.1, 0.0, 0.3, 1.2, 2.9] {
+        let coupling = map.coupling_equation(&g);
+        for alpha in [-2.5, -0.7, -0.1, 0.0, 0.3, 1.2, 2.9, PI] {
             let (s, co) = f64::sin_cos(alpha);
             let p = map.at(alpha);
             let k =
@@ -1067,13 +1037,10 @@ mod tests {
             let r2s2 = g.r_big1 * g.r_big1 * s * s;
             let u = p.x + g.dx1;
             let eq15 = r2s2 * u * u + k * p.y * p.y - r2s2 * (g.l1 * g.l1 - k);
-            let t = (alpha / 2.0).tan();
-            let poly = c.iter().rev().fold(0.0, |acc, a| acc * t + a);
-            let tt = (1.0 + t * t).powi(3);
+            let got = coupling.eval(alpha);
             assert!(
-                (poly - eq15 * tt).abs() < 1e-9 * (1.0 + poly.abs()),
-                "{alpha}: {poly} vs {}",
-                eq15 * tt
+                (got - eq15).abs() < 1e-9 * (1.0 + eq15.abs()),
+                "{alpha}: {got} vs {eq15}"
             );
         }
     }
