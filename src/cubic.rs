@@ -168,17 +168,7 @@ pub fn deflated_roots_in(c: &[f64; 4], w: f64, lo: f64, hi: f64) -> Option<Array
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// Uniform numbers in [0, 1) from a fixed seed (a 64-bit LCG).
-    fn lcg(seed: u64) -> impl FnMut() -> f64 {
-        let mut s = seed;
-        move || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        }
-    }
+    use crate::test_rng::lcg;
 
     fn from_roots(rs: [f64; 3], lead: f64) -> [f64; 4] {
         let [r1, r2, r3] = rs;

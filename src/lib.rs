@@ -25,6 +25,8 @@ pub mod plot;
 pub mod poly;
 pub mod selftest;
 pub mod table;
+#[cfg(test)]
+mod test_rng;
 pub mod tolerance;
 pub mod trig;
 pub mod verify;

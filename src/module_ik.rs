@@ -990,13 +990,7 @@ mod tests {
     /// always +0); ends and far angles included.
     #[test]
     fn wrap_angle_one_turn_out_is_the_remainder() {
-        let mut s = 0x9e37_79b9_7f4a_7c15u64;
-        let mut unit = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut unit = crate::test_rng::lcg(0x9e37_79b9_7f4a_7c15);
         let mut angles = vec![PI, -PI, 3.0 * PI, -3.0 * PI, TAU, -TAU, 0.0, 1e300, -7.5e3];
         for k in [PI, 3.0 * PI, TAU] {
             angles.extend([k.next_up(), k.next_down(), -k.next_up(), -k.next_down()]);

@@ -869,13 +869,8 @@ mod tests {
 
     #[test]
     fn agrees_with_the_half_angle_charts() {
-        let mut state = 0x1234_5678_9abc_def0u64;
-        let mut unit = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let mut uniform = crate::test_rng::lcg(0x1234_5678_9abc_def0);
+        let mut unit = || uniform() * 2.0 - 1.0;
         for _ in 0..3000 {
             let mut p = Trig::default();
             for k in 0..=MAX_HARMONIC {
