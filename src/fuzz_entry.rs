@@ -5,6 +5,8 @@
 use std::io::Cursor;
 
 use crate::machine::Machine;
+use crate::machine_kin::FirstRowChoice;
+use crate::machine_rows::{MachineIk, OrientationColumns};
 use crate::module_rows::{ModuleFk, ModuleIk};
 use crate::pipeline::{self, Units};
 use crate::table::{CsvSource, Sink};
@@ -37,6 +39,31 @@ pub fn csv_rows(data: &[u8], fk: bool) {
                 &|_| {},
             )
         };
+    }
+}
+
+/// CSV tool poses (x,y,z with i,j,k or phi1,phi2) through the machine inverse kinematics along
+/// a path (`verne ik` on a toolpath), every branch (`--all`) and the followed one.
+pub fn csv_tool_rows(data: &[u8]) {
+    for orientation in [OrientationColumns::Axis, OrientationColumns::Angles] {
+        for all in [true, false] {
+            let Ok(mut source) =
+                CsvSource::from_reader(Box::new(Cursor::new(data.to_vec())), "fuzz")
+            else {
+                return;
+            };
+            let mut sink = Sink::from_writer(Box::new(std::io::sink()), "sink");
+            let machine = Machine::default_verne();
+            let tool_length = machine.tool_length;
+            let mut job = MachineIk::new(
+                machine,
+                tool_length,
+                orientation,
+                all,
+                FirstRowChoice::default(),
+            );
+            let _ = pipeline::run(&mut job, &mut source, &mut sink, Units::default(), &|_| {});
+        }
     }
 }
 

@@ -24,6 +24,7 @@ fn fuzz_corpus_replays_without_panics() {
     let counts = [
         replay("csv_ik", |d| verne::fuzz_entry::csv_rows(d, false)),
         replay("csv_fk", |d| verne::fuzz_entry::csv_rows(d, true)),
+        replay("csv_tool", verne::fuzz_entry::csv_tool_rows),
         replay("machine_file", verne::fuzz_entry::machine_file),
         replay("apt_file", verne::fuzz_entry::apt_file),
         replay("arg_values", verne::fuzz_entry::arg_values),
