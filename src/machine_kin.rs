@@ -51,6 +51,11 @@ use crate::trig::{MAX_TRIG_ROOTS, Trig, TrigRoot, sin_cos_after_step};
 /// Trying both signs more often than needed only costs a Newton polish and a duplicate check.
 pub const BOTH_SIGNS_SIN_ALPHA: f64 = 1e-4;
 
+/// F at sin(alpha) = 0, relative to its largest coefficient, below which that angle is also
+/// polished as a seed (a double root of F there, within rounding, or nearly one). Above it the
+/// seed only costs Newton runs that end on roots already found (a quarter of the IK's time).
+pub const ALPHA_ZERO_SEED_REL: f64 = 1e-8;
+
 /// Most real (theta1, rho1) pairs: the six roots of the degree-6 polynomial in tan(theta1/2)
 /// (a double root at sin(alpha) = 0 is two pairs, one per sign of rho1 - zp).
 pub const MAX_THETA1_SOLUTIONS: usize = 6;
@@ -353,17 +358,27 @@ pub fn machine_ik(m: &Machine, pose: &ToolPose, tool_length: f64) -> MachineIkBr
         cos_phi1,
     };
     let f = theta1_equation(m, pose, tool_length);
-    // Seeds: the roots of F on the circle, plus the two values where sin(alpha) = 0, F's double
-    // roots (flagged: both signs of rho1 - zp there, Table II of IFToMM 2007). Elsewhere the sign
-    // comes from eq. (14), even at a double root of F (a tangency, where it is still defined).
+    // Seeds: the roots of F on the circle, plus the two values where sin(alpha) = 0 when F is
+    // near zero there: its double roots (flagged: both signs of rho1 - zp there, Table II of
+    // IFToMM 2007). At sin(alpha) = 0, F = yp^2 (R1 -/+ r1)^2 >= 0, a double root iff yp = 0;
+    // where F is clearly positive there, the roots nearby are simple and isolated (and with
+    // sin(alpha) that small both signs are tried anyway). Elsewhere the sign comes from eq. (14),
+    // even at a double root of F (a tangency, where it is still defined).
     let mut seeds: ArrayVec<(TrigRoot, bool), { MAX_TRIG_ROOTS + 2 }> = f
         .roots_sin_cos()
         .into_iter()
         .map(|root| (root, false))
         .collect();
+    let f_scale = f
+        .cos
+        .iter()
+        .chain(&f.sin)
+        .fold(0.0f64, |m, a| m.max(a.abs()));
     for th in [-pose.phi1, PI - pose.phi1] {
         let (sin, cos) = th.sin_cos();
-        seeds.push((TrigRoot { x: th, sin, cos }, true));
+        if f.eval_sc(sin, cos) <= ALPHA_ZERO_SEED_REL * f_scale {
+            seeds.push((TrigRoot { x: th, sin, cos }, true));
+        }
     }
     let mut pairs: ArrayVec<PathPoint, MAX_THETA1_SOLUTIONS> = ArrayVec::new();
     for (root, at_alpha_zero) in seeds {

@@ -482,6 +482,46 @@ fn double_root_at_alpha_zero_gives_both_leg1_postures() {
     assert!((working[0].platform - p).amax() < 1e-9);
 }
 
+/// Near the double roots at sin(alpha) = 0 (F = yp^2 (R1 -/+ r1)^2 there, zero iff yp = 0): tilted
+/// tools whose tip puts yp at those angles at 0 or a little off it. Either F has a double root
+/// there (both signs of rho1 - zp) or two simple roots close by (one posture each): two leg-I
+/// postures near each such angle whenever leg I reaches it, and each is a solution of the
+/// unsquared leg-I pair at its own theta1.
+#[test]
+fn near_double_roots_at_alpha_zero_keep_both_postures() {
+    let m = Machine::default_verne();
+    let d_t = m.table.d_t;
+    let mut near = 0;
+    for phi1 in [0.1f64, 0.3, -0.2] {
+        for (x, z) in [(-120.0, 0.0), (-60.0, 40.0), (0.0, 120.0)] {
+            // yp(theta1 = -phi1) = 0 (and yp(pi - phi1) = 0: it is its negative).
+            let y0 = DELTA * phi1.sin() + phi1.tan() * (d_t - z - DELTA * phi1.cos());
+            for eps in [0.0, 1e-12, -1e-9, 1e-6, -1e-3, 0.03, 1.0] {
+                let pose = ToolPose {
+                    tip: Vector3::new(x, y0 + eps, z),
+                    phi1,
+                    phi2: 0.0,
+                };
+                let ik = machine_ik(&m, &pose, DELTA);
+                for th in [-phi1, PI - phi1] {
+                    let mut rho1: Vec<f64> = ik
+                        .iter()
+                        .filter(|b| wrap_angle(b.theta1 - th).abs() < 0.05)
+                        .map(|b| b.rho.x)
+                        .collect();
+                    rho1.sort_by(f64::total_cmp);
+                    rho1.dedup_by(|a, b| (*a - *b).abs() < 1e-6);
+                    if !rho1.is_empty() {
+                        near += 1;
+                        assert_eq!(rho1.len(), 2, "{pose:?} near theta1 = {th}: {rho1:?}");
+                    }
+                }
+            }
+        }
+    }
+    assert!(near > 20, "too few reachable cases: {near}");
+}
+
 /// A path whose tool axis sweeps through the table normal in the y-z plane, then circles it at a
 /// small tilt: theta2 must not jump by a turn (or half a turn), the singular rows are flagged,
 /// and the tip is always reached.
