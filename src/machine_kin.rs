@@ -714,14 +714,28 @@ impl PathState {
     pub fn choose(&mut self, candidates: &PathCandidates) -> Result<PathRow, PathError> {
         let options = &candidates.options;
         let near_singular = candidates.near_singular;
+        // theta2 unwrapped next to the previous row's; every branch of an orientation solution
+        // has the same theta2, so each value is unwrapped once (an `fmod` once the rotary axis
+        // has turned more than once).
+        let mut unwrapped = ArrayVec::<(u64, f64), 2>::new();
+        let mut unwrap = |t: f64| {
+            let Some(p) = self.prev else {
+                return t;
+            };
+            if let Some(&(_, u)) = unwrapped.iter().find(|(bits, _)| *bits == t.to_bits()) {
+                return u;
+            }
+            let u = unwrap_near(t, p.theta2);
+            if !unwrapped.is_full() {
+                unwrapped.push((t.to_bits(), u));
+            }
+            u
+        };
         let all: ArrayVec<Candidate, { 2 * MAX_MACHINE_IK_BRANCHES }> = candidates
             .all
             .iter()
             .map(|c| Candidate {
-                theta2: match self.prev {
-                    Some(p) => unwrap_near(c.theta2, p.theta2),
-                    None => c.theta2,
-                },
+                theta2: unwrap(c.theta2),
                 ..*c
             })
             .collect();
