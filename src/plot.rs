@@ -95,6 +95,8 @@ macro_rules! render {
     ($path:expr, $size:expr, $draw:expr) => {{
         let path: &Path = $path;
         register_font();
+        // A device or a FIFO is written in place (see `table::output_destination`).
+        let dest = crate::table::output_destination(path);
         match Format::of_path(path)? {
             Format::Svg => {
                 let mut text = String::new();
@@ -103,28 +105,42 @@ macro_rules! render {
                     $draw(&root)?;
                     root.present().map_err(|e| io_err(path, e))?;
                 }
-                let tmp = temp_path(path, false);
-                std::fs::write(&tmp, text.as_bytes())
-                    .and_then(|_| std::fs::rename(&tmp, path))
-                    .map_err(|e| {
-                        let _ = std::fs::remove_file(&tmp);
-                        io_err(path, e)
-                    })
+                if dest.in_place {
+                    std::fs::write(&dest.path, text.as_bytes()).map_err(|e| io_err(path, e))
+                } else {
+                    let tmp = temp_path(&dest.path, false);
+                    std::fs::write(&tmp, text.as_bytes())
+                        .and_then(|_| std::fs::rename(&tmp, &dest.path))
+                        .map_err(|e| {
+                            let _ = std::fs::remove_file(&tmp);
+                            io_err(path, e)
+                        })
+                }
             }
             Format::Png => {
                 // The bitmap encoder picks the format from the extension: keep it.
-                let tmp = temp_path(path, true);
+                let tmp = if dest.in_place {
+                    dest.path.clone()
+                } else {
+                    temp_path(&dest.path, true)
+                };
                 let drawn = (|| -> Result<(), String> {
                     let root = BitMapBackend::new(&tmp, $size).into_drawing_area();
                     $draw(&root)?;
                     root.present().map_err(|e| io_err(path, e))
                 })();
-                drawn
-                    .and_then(|_| std::fs::rename(&tmp, path).map_err(|e| io_err(path, e)))
-                    .map_err(|e| {
-                        let _ = std::fs::remove_file(&tmp);
-                        e
-                    })
+                if dest.in_place {
+                    drawn
+                } else {
+                    drawn
+                        .and_then(|_| {
+                            std::fs::rename(&tmp, &dest.path).map_err(|e| io_err(path, e))
+                        })
+                        .map_err(|e| {
+                            let _ = std::fs::remove_file(&tmp);
+                            e
+                        })
+                }
             }
         }
     }};

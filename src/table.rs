@@ -272,13 +272,22 @@ impl Sink {
         let (writer, target, name): (Box<dyn Write + Send>, _, String) = match path {
             Some(p) if p.as_os_str() != "-" => {
                 let name = p.display().to_string();
-                let tmp = temp_path_for(p);
-                let f = File::create(&tmp).map_err(|e| VerneError::io(&name, e))?;
-                (
-                    Box::new(BufWriter::with_capacity(1 << 16, f)),
-                    Some((tmp, p.to_path_buf())),
-                    name,
-                )
+                let dest = output_destination(p);
+                if dest.in_place {
+                    let f = std::fs::OpenOptions::new()
+                        .write(true)
+                        .open(&dest.path)
+                        .map_err(|e| VerneError::io(&name, e))?;
+                    (Box::new(BufWriter::with_capacity(1 << 16, f)), None, name)
+                } else {
+                    let tmp = temp_path_for(&dest.path);
+                    let f = File::create(&tmp).map_err(|e| VerneError::io(&name, e))?;
+                    (
+                        Box::new(BufWriter::with_capacity(1 << 16, f)),
+                        Some((tmp, dest.path)),
+                        name,
+                    )
+                }
             }
             _ => (
                 Box::new(BufWriter::with_capacity(1 << 16, io::stdout())),
@@ -380,6 +389,36 @@ impl Sink {
 impl Drop for Sink {
     fn drop(&mut self) {
         self.discard();
+    }
+}
+
+/// Where an output file is written ([`output_destination`]).
+pub struct OutputDestination {
+    /// The file to write or to rename into place (a symlink's target).
+    pub path: PathBuf,
+    /// Written directly, not through a temporary file renamed into place.
+    pub in_place: bool,
+}
+
+/// Where output named `path` goes. A device, a FIFO or a socket (`/dev/null`, `/dev/stdout`, a
+/// named pipe) is written in place: renaming a file over it would replace the node itself (and
+/// `/dev/null` with it, for root). Anything else goes through a temporary file beside the
+/// final file, renamed into place on success; a symlink is followed, so that it keeps pointing
+/// at the output.
+pub fn output_destination(path: &Path) -> OutputDestination {
+    match std::fs::metadata(path) {
+        Ok(m) if !m.is_file() && !m.is_dir() => OutputDestination {
+            path: path.to_path_buf(),
+            in_place: true,
+        },
+        Ok(_) if path.is_symlink() => OutputDestination {
+            path: std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf()),
+            in_place: false,
+        },
+        _ => OutputDestination {
+            path: path.to_path_buf(),
+            in_place: false,
+        },
     }
 }
 

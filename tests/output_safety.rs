@@ -1,5 +1,6 @@
 //! Output safety: an interrupted run leaves no partial and no temporary file; a full disk and a
-//! closed pipe end the run cleanly; every input row yields exactly one output row.
+//! closed pipe end the run cleanly; every input row yields exactly one output row; a device or a
+//! symlink given as the output is written, not replaced.
 
 use std::io::Write;
 use std::process::{Command, Stdio};
@@ -212,4 +213,38 @@ fn output_is_the_same_with_one_and_two_threads() {
         assert_eq!(two, run(args, &joints, "1"), "{args:?}");
         assert_eq!(two, run(args, &joints, "3"), "{args:?}");
     }
+}
+
+/// An output path that is a device or a symlink stays what it is: `/dev/null` is written in place
+/// (a temporary file renamed over it would replace the device node, for root), and a symlink
+/// keeps pointing at its file, which now holds the output.
+#[cfg(unix)]
+#[test]
+fn devices_and_symlinks_are_written_not_replaced() {
+    use std::os::unix::fs::FileTypeExt;
+    let pose = "--pose=-240,-86,1000";
+    let status = Command::new(BIN)
+        .args(["ik", pose, "-o", "/dev/null"])
+        .stderr(Stdio::null())
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let null = std::fs::metadata("/dev/null").unwrap().file_type();
+    assert!(null.is_char_device(), "/dev/null is no longer a device");
+
+    let d = temp_dir("symlink");
+    std::fs::write(d.join("real.csv"), "old\n").unwrap();
+    std::os::unix::fs::symlink("real.csv", d.join("link.csv")).unwrap();
+    let status = Command::new(BIN)
+        .args(["ik", pose, "-o"])
+        .arg(d.join("link.csv"))
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let link = std::fs::symlink_metadata(d.join("link.csv")).unwrap();
+    assert!(link.file_type().is_symlink(), "the symlink was replaced");
+    let text = std::fs::read_to_string(d.join("real.csv")).unwrap();
+    assert!(text.starts_with("xp,yp,zp,alpha,"), "{text}");
+    assert_eq!(text.lines().count(), 2, "{text}");
+    let _ = std::fs::remove_dir_all(&d);
 }

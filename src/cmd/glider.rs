@@ -887,6 +887,11 @@ fn write_workspace_points(
 /// Writes text to `path` through a temporary file beside it, renamed into place.
 fn write_atomic(path: &Path, text: &str) -> Result<(), VerneError> {
     let name = path.display().to_string();
+    let dest = verne::table::output_destination(path);
+    if dest.in_place {
+        return std::fs::write(&dest.path, text).map_err(|e| VerneError::io(&name, e));
+    }
+    let path = dest.path.as_path();
     let file = path
         .file_name()
         .map(|f| f.to_string_lossy().into_owned())
