@@ -67,18 +67,17 @@ pub fn outcome_color(o: Outcome) -> RGBColor {
     }
 }
 
-fn temp_path(path: &Path, keep_ext: bool) -> PathBuf {
+/// `dir/.name.verne-PID.tmp.ext` beside `path`: the bitmap encoder picks its format from the
+/// extension.
+fn temp_path_keeping_extension(path: &Path) -> PathBuf {
     let name = path
         .file_name()
         .map(|f| f.to_string_lossy().into_owned())
         .unwrap_or_else(|| "picture".into());
-    let ext = if keep_ext {
-        path.extension()
-            .map(|e| format!(".{}", e.to_string_lossy()))
-            .unwrap_or_default()
-    } else {
-        String::new()
-    };
+    let ext = path
+        .extension()
+        .map(|e| format!(".{}", e.to_string_lossy()))
+        .unwrap_or_default();
     let tmp = format!(".{name}.verne-{}.tmp{ext}", std::process::id());
     match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.join(tmp),
@@ -105,24 +104,14 @@ macro_rules! render {
                     $draw(&root)?;
                     root.present().map_err(|e| io_err(path, e))?;
                 }
-                if dest.in_place {
-                    std::fs::write(&dest.path, text.as_bytes()).map_err(|e| io_err(path, e))
-                } else {
-                    let tmp = temp_path(&dest.path, false);
-                    std::fs::write(&tmp, text.as_bytes())
-                        .and_then(|_| std::fs::rename(&tmp, &dest.path))
-                        .map_err(|e| {
-                            let _ = std::fs::remove_file(&tmp);
-                            io_err(path, e)
-                        })
-                }
+                crate::table::write_output(path, text.as_bytes()).map_err(|e| io_err(path, e))
             }
             Format::Png => {
                 // The bitmap encoder picks the format from the extension: keep it.
                 let tmp = if dest.in_place {
                     dest.path.clone()
                 } else {
-                    temp_path(&dest.path, true)
+                    temp_path_keeping_extension(&dest.path)
                 };
                 let drawn = (|| -> Result<(), String> {
                     let root = BitMapBackend::new(&tmp, $size).into_drawing_area();

@@ -422,6 +422,22 @@ pub fn output_destination(path: &Path) -> OutputDestination {
     }
 }
 
+/// Writes `bytes` as the output file `path`, as [`Sink`] does: through a temporary file beside
+/// it, renamed into place (nothing is left behind on an error), or in place for a device or a
+/// FIFO ([`output_destination`]).
+pub fn write_output(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    let dest = output_destination(path);
+    if dest.in_place {
+        return std::fs::write(&dest.path, bytes);
+    }
+    let tmp = temp_path_for(&dest.path);
+    std::fs::write(&tmp, bytes)
+        .and_then(|_| std::fs::rename(&tmp, &dest.path))
+        .inspect_err(|_| {
+            let _ = std::fs::remove_file(&tmp);
+        })
+}
+
 /// `dir/.name.verne-PID.tmp` beside the target.
 fn temp_path_for(p: &Path) -> PathBuf {
     let file = p

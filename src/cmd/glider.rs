@@ -7,7 +7,7 @@
 //! singular. Otherwise its status lists why, codes joined by `;`.
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::OnceLock;
 
 use arrayvec::ArrayVec;
@@ -884,25 +884,10 @@ fn write_workspace_points(
     sink.finish()
 }
 
-/// Writes text to `path` through a temporary file beside it, renamed into place.
+/// Writes text to `path` as every output file is written ([`verne::table::write_output`]).
 fn write_atomic(path: &Path, text: &str) -> Result<(), VerneError> {
-    let name = path.display().to_string();
-    let dest = verne::table::output_destination(path);
-    if dest.in_place {
-        return std::fs::write(&dest.path, text).map_err(|e| VerneError::io(&name, e));
-    }
-    let path = dest.path.as_path();
-    let file = path
-        .file_name()
-        .map(|f| f.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "plot.svg".into());
-    let tmp: PathBuf = path.with_file_name(format!(".{file}.verne-{}.tmp", std::process::id()));
-    let result = std::fs::write(&tmp, text).and_then(|_| std::fs::rename(&tmp, path));
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(VerneError::io(&name, e));
-    }
-    Ok(())
+    verne::table::write_output(path, text.as_bytes())
+        .map_err(|e| VerneError::io(&path.display().to_string(), e))
 }
 
 /// An SVG picture: nodes by class (run-length rectangles per grid row), the rectangle S (red),
@@ -1054,6 +1039,7 @@ fn branch_row(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::path::PathBuf;
 
     fn scratch(name: &str) -> PathBuf {
         let dir = std::env::temp_dir().join(format!("verne-glider-{}-{name}", std::process::id()));
