@@ -256,18 +256,49 @@ fn rod_too_tilted(rz: f64, norm_sq: f64, cos_tilt_max: f64) -> bool {
 pub fn outer_leg_states(
     m: &Machine,
     leg: usize,
-    (dx, dy, h): (f64, f64, f64),
+    dx_dy_h: (f64, f64, f64),
     rho: [f64; 2],
     cos_tilt_max: f64,
 ) -> [LegState; 2] {
+    outer_leg_pair(leg, dx_dy_h, cos_tilt_max, |k| {
+        outside_stroke(m, leg, rho[k])
+    })
+}
+
+/// [`outer_leg_states`] but the strokes: the label and verdict of leg II or III at both roots
+/// of its eq. (12) or (13) as far as they depend on the square root alone, which a leg-I
+/// posture shares with its mirror image (same cos(alpha)). Add [`stroke_verdict`] of each rho.
+#[inline]
+pub fn outer_leg_labels(
+    leg: usize,
+    dx_dy_h: (f64, f64, f64),
+    cos_tilt_max: f64,
+) -> [(i8, Verdict); 2] {
+    outer_leg_pair(leg, dx_dy_h, cos_tilt_max, |_| false).map(LegState::check)
+}
+
+/// The states of [`outer_leg_states`], root k outside its stroke when `outside(k)`.
+#[inline(always)]
+fn outer_leg_pair(
+    leg: usize,
+    (dx, dy, h): (f64, f64, f64),
+    cos_tilt_max: f64,
+    outside: impl Fn(usize) -> bool,
+) -> [LegState; 2] {
     let norm_sq = dx * dx + dy * dy + h * h;
-    let state = |q: f64, rho_i: f64| LegState {
+    let state = |k: usize, q: f64| LegState {
         leg,
         q,
         tilted: rod_too_tilted(-q, norm_sq, cos_tilt_max),
-        outside_stroke: outside_stroke(m, leg, rho_i),
+        outside_stroke: outside(k),
     };
-    [state(-h, rho[0]), state(h, rho[1])]
+    [state(0, -h), state(1, h)]
+}
+
+/// The stroke reason of slider `leg` (0, 1, 2) at `rho_i`, when it is outside its stroke.
+#[inline]
+pub fn stroke_verdict(m: &Machine, leg: usize, rho_i: f64) -> Verdict {
+    Verdict((outside_stroke(m, leg, rho_i) as u16) << (Reason::Rho1Stroke as u16 + leg as u16))
 }
 
 /// cos of the largest rod tilt with its slack, for [`leg_state`].

@@ -14,7 +14,8 @@ use arrayvec::ArrayVec;
 use nalgebra::Vector3;
 
 use crate::branches::{
-    Config, Verdict, WORKING_CONFIG, cos_tilt_max, leg_state, outer_leg_states, rods_cross,
+    Config, Verdict, WORKING_CONFIG, cos_tilt_max, leg_state, outer_leg_labels, outer_leg_states,
+    rods_cross, stroke_verdict,
 };
 use crate::cubic::{cubic_roots_in, deflated_roots_in};
 use crate::machine::{Machine, ModuleGeometry};
@@ -92,25 +93,24 @@ fn leg1_height_sq(g: &ModuleGeometry, p: &Vector3<f64>, c: f64) -> f64 {
 /// With it, the others are all below r1/R1: from the cubic divided by the known root (no
 /// isolation), unless that is a close call. Empty when the cubic is degenerate.
 fn other_roots(g: &ModuleGeometry, p: &Vector3<f64>, certified: Option<Leg1>) -> ArrayVec<f64, 8> {
-    let Some(coeffs) = cubic_eq9(g, p) else {
-        return ArrayVec::new();
-    };
-    let (r, rr) = (g.r_big1, g.r_small1);
-    match certified {
-        Some(leg1) => {
-            let hi = rr / r - FAST_MARGIN_RAD;
-            match deflated_roots_in(&coeffs, leg1.cos, -1.0, hi) {
-                Some(roots) => roots.into_iter().collect(),
-                None => cubic_roots_in(&coeffs, -1.0, hi)
-                    .iter()
-                    .map(|t| t.x)
-                    .collect(),
-            }
-        }
-        None => cubic_roots_in(&coeffs, -1.0, 1.0)
+    let all_roots = |lo: f64, hi: f64| match cubic_eq9(g, p) {
+        Some(coeffs) => cubic_roots_in(&coeffs, lo, hi)
             .iter()
             .map(|t| t.x)
             .collect(),
+        None => ArrayVec::new(),
+    };
+    match certified {
+        // The certificate saw finite coefficients with c3 > 0, and the division's thresholds
+        // are relative to the coefficients' size: no normalisation needed.
+        Some(leg1) => {
+            let hi = g.r_small1 / g.r_big1 - FAST_MARGIN_RAD;
+            match deflated_roots_in(&eq9_coefficients(g, p), leg1.cos, -1.0, hi) {
+                Some(roots) => roots.into_iter().collect(),
+                None => all_roots(-1.0, hi),
+            }
+        }
+        None => all_roots(-1.0, 1.0),
     }
 }
 
@@ -535,13 +535,21 @@ fn branches_into(m: &Machine, p: &Vector3<f64>, legs1: &ArrayVec<Leg1, 6>, out: 
         return;
     }
     let cos_tilt = cos_tilt_max(m);
-    // Branches come out ordered by alpha, then (s1, s2, s3): postures sorted by (alpha, s1), and
-    // within a posture s2, s3 = -1 before +1 (the roots of (12)-(13) in increasing order).
+    // Leg I's label per posture; legs II and III once per cos(alpha): a posture and its mirror
+    // image (next to each other in `legs1`) share them.
     let n = legs1.len();
     let mut checks = [(0i8, Verdict::default()); 6];
+    let mut outer = [None; 6];
     for (k, l) in legs1.iter().enumerate() {
         checks[k] = leg_state(m, 0, p, l.sin, l.cos, l.rho1, cos_tilt).check();
+        outer[k] = if k > 0 && l.cos == legs1[k - 1].cos {
+            outer[k - 1]
+        } else {
+            outer_legs(m, p, l.cos, cos_tilt)
+        };
     }
+    // Branches come out ordered by alpha, then (s1, s2, s3): postures sorted by (alpha, s1), and
+    // within a posture s2, s3 = -1 before +1 (the roots of (12)-(13) in increasing order).
     // Postures come in pairs (alpha >= 0, its mirror) by increasing cos(alpha): the mirrors in
     // that order, then the others in reverse, is usually the order already; sorted if not.
     let mut order = [0usize; 6];
@@ -555,28 +563,106 @@ fn branches_into(m: &Machine, p: &Vector3<f64>, legs1: &ArrayVec<Leg1, 6>, out: 
             order[back] = k;
         }
     }
-    let key = |k: usize| (legs1[k].alpha, checks[k].0);
-    let before = |a: usize, b: usize| {
-        let (ka, kb) = (key(a), key(b));
-        ka.0.total_cmp(&kb.0).then(ka.1.cmp(&kb.1))
-    };
-    if order[..n].windows(2).any(|w| before(w[0], w[1]).is_gt()) {
-        order[..n].sort_unstable_by(|&a, &b| before(a, b));
+    let order = &mut order[..n];
+    // In order when each alpha is below the next, or the same (bit for bit) with s1 no larger:
+    // what the sort's comparison says, without it.
+    let in_order = order.windows(2).all(|w| {
+        let (a, b) = (&legs1[w[0]], &legs1[w[1]]);
+        a.alpha < b.alpha
+            || (a.alpha.to_bits() == b.alpha.to_bits() && checks[w[0]].0 <= checks[w[1]].0)
+    });
+    if !in_order {
+        let key = |k: usize| (legs1[k].alpha, checks[k].0);
+        order.sort_unstable_by(|&a, &b| {
+            let (ka, kb) = (key(a), key(b));
+            ka.0.total_cmp(&kb.0).then(ka.1.cmp(&kb.1))
+        });
     }
-    for &k in &order[..n] {
-        if let Some(four) = posture_branches(m, p, &legs1[k], checks[k], cos_tilt) {
-            let pushed = out.try_extend_from_slice(&four);
-            debug_assert!(
-                pushed.is_ok(),
-                "six postures of four branches fit MAX_IK_BRANCHES"
-            );
+    for &k in order.iter() {
+        if let Some(o) = &outer[k] {
+            for b in four_branches(m, p, &legs1[k], checks[k], o) {
+                let pushed = out.try_push(b);
+                debug_assert!(
+                    pushed.is_ok(),
+                    "six postures of four branches fit MAX_IK_BRANCHES"
+                );
+            }
         }
     }
 }
 
+/// Legs II and III at a leg-I posture as far as they depend on its cos(alpha) alone (a posture
+/// and its mirror image share them): the square roots of eqs. (12)-(13) and each root's label
+/// and verdict but the stroke.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct OuterLegs {
+    /// sqrt(L2^2 - (xp + D2 - d2)^2 - (yp - R2 cos a + r4)^2) and its eq. (13) counterpart.
+    h: [f64; 2],
+    /// [leg II, leg III][lower root, upper root].
+    labels: [[(i8, Verdict); 2]; 2],
+}
+
+/// [`OuterLegs`] of `p` at cos(alpha) = `c`; None when leg II or III cannot reach.
+#[inline(always)]
+pub(crate) fn outer_legs(
+    m: &Machine,
+    p: &Vector3<f64>,
+    c: f64,
+    cos_tilt: f64,
+) -> Option<OuterLegs> {
+    let g = &m.module;
+    let dx2 = p.x + g.dx2;
+    // eq. (12): rho2 = zp - R2 sin a + s2 sqrt(L2^2 - (xp + D2 - d2)^2 - (yp - R2 cos a + r4)^2)
+    let dy2 = p.y - g.r_big2 * c + g.r4;
+    let h2 = leg_root(g.l2, dx2, dy2)?;
+    // eq. (13): rho3 = zp + R2 sin a + s3 sqrt(L3^2 - (xp + D2 - d2)^2 - (yp + R2 cos a - r4)^2)
+    let dy3 = p.y + g.r_big2 * c - g.r4;
+    let h3 = leg_root(g.l3, dx2, dy3)?;
+    Some(OuterLegs {
+        h: [h2, h3],
+        labels: [
+            outer_leg_labels(1, (dx2, dy2, h2), cos_tilt),
+            outer_leg_labels(2, (dx2, dy3, h3), cos_tilt),
+        ],
+    })
+}
+
 /// The four branches of `p` on the leg-I posture `leg1` (s2, s3 = -1 before +1: the roots of
-/// (12)-(13) in increasing order), labelled; None when leg II or III cannot reach. `l1` is leg
-/// I's label and verdict at the posture, `cos_tilt` [`cos_tilt_max`].
+/// (12)-(13) in increasing order), labelled. `l1` is leg I's label and verdict at the posture,
+/// `outer` the posture's [`outer_legs`].
+#[inline(always)]
+fn four_branches(
+    m: &Machine,
+    p: &Vector3<f64>,
+    leg1: &Leg1,
+    l1: (i8, Verdict),
+    outer: &OuterLegs,
+) -> [IkBranch; 4] {
+    let g = &m.module;
+    let (off2, off3) = (p.z - g.r_big2 * leg1.sin, p.z + g.r_big2 * leg1.sin);
+    let [h2, h3] = outer.h;
+    let (r2, r3) = ([off2 - h2, off2 + h2], [off3 - h3, off3 + h3]);
+    let leg = |i: usize, rho: [f64; 2]| {
+        let [a, b] = outer.labels[i - 1];
+        [
+            (a.0, a.1.with(stroke_verdict(m, i, rho[0]))),
+            (b.0, b.1.with(stroke_verdict(m, i, rho[1]))),
+        ]
+    };
+    let (l2, l3) = (leg(1, r2), leg(2, r3));
+    let v1 = l1.1.with(rods_cross(m, leg1.cos));
+    let branch = |k2: usize, k3: usize| IkBranch {
+        alpha: leg1.alpha,
+        rho: Sliders::new(leg1.rho1, r2[k2], r3[k3]),
+        config: [l1.0, l2[k2].0, l3[k3].0],
+        verdict: v1.with(l2[k2].1).with(l3[k3].1),
+    };
+    [branch(0, 0), branch(0, 1), branch(1, 0), branch(1, 1)]
+}
+
+/// The four branches of `p` on the leg-I posture `leg1` ([`four_branches`]); None when leg II or
+/// III cannot reach. `l1` is leg I's label and verdict at the posture, `cos_tilt`
+/// [`cos_tilt_max`].
 #[inline(always)]
 pub(crate) fn posture_branches(
     m: &Machine,
@@ -585,29 +671,8 @@ pub(crate) fn posture_branches(
     l1: (i8, Verdict),
     cos_tilt: f64,
 ) -> Option<[IkBranch; 4]> {
-    let g = &m.module;
-    let (s, c) = (leg1.sin, leg1.cos);
-    let dx2 = p.x + g.dx2;
-    // eq. (12): rho2 = zp - R2 sin a + s2 sqrt(L2^2 - (xp + D2 - d2)^2 - (yp - R2 cos a + r4)^2)
-    let (dy2, off2) = (p.y - g.r_big2 * c + g.r4, p.z - g.r_big2 * s);
-    let h2 = leg_root(g.l2, dx2, dy2)?;
-    // eq. (13): rho3 = zp + R2 sin a + s3 sqrt(L3^2 - (xp + D2 - d2)^2 - (yp + R2 cos a - r4)^2)
-    let (dy3, off3) = (p.y + g.r_big2 * c - g.r4, p.z + g.r_big2 * s);
-    let h3 = leg_root(g.l3, dx2, dy3)?;
-    let (r2, r3) = ([off2 - h2, off2 + h2], [off3 - h3, off3 + h3]);
-    // Labels and verdicts leg by leg: leg I once per posture, legs II and III once per pair of
-    // roots.
-    let [l2a, l2b] = outer_leg_states(m, 1, (dx2, dy2, h2), r2, cos_tilt);
-    let [l3a, l3b] = outer_leg_states(m, 2, (dx2, dy3, h3), r3, cos_tilt);
-    let (l2, l3) = ([l2a.check(), l2b.check()], [l3a.check(), l3b.check()]);
-    let v1 = l1.1.with(rods_cross(m, c));
-    let branch = |k2: usize, k3: usize| IkBranch {
-        alpha: leg1.alpha,
-        rho: Sliders::new(leg1.rho1, r2[k2], r3[k3]),
-        config: [l1.0, l2[k2].0, l3[k3].0],
-        verdict: v1.with(l2[k2].1).with(l3[k3].1),
-    };
-    Some([branch(0, 0), branch(0, 1), branch(1, 0), branch(1, 1)])
+    let outer = outer_legs(m, p, leg1.cos, cos_tilt)?;
+    Some(four_branches(m, p, leg1, l1, &outer))
 }
 
 /// How far (mm) a configuration sign or a square root must be from zero, and (rad) two candidate
