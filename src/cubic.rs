@@ -135,6 +135,7 @@ const DEFLATED_END_MARGIN: f64 = 1e-9;
 /// call (a discriminant near zero: a close pair or double root; a root near `lo` or `hi`), so
 /// that [`cubic_roots_in`] decides; a caller polishes the roots on its own equations (the
 /// deflation adds a rounding error of the order of `w`'s).
+#[inline]
 pub fn deflated_roots_in(c: &[f64; 4], w: f64, lo: f64, hi: f64) -> Option<ArrayVec<f64, 2>> {
     // Synthetic division: c = (x - w) (a x^2 + b x + k) + remainder.
     let a = c[3];

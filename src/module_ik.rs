@@ -92,6 +92,7 @@ fn leg1_height_sq(g: &ModuleGeometry, p: &Vector3<f64>, c: f64) -> f64 {
 /// [`certified_lanes`] posture, when it has one), in increasing order: all of them without it.
 /// With it, the others are all below r1/R1: from the cubic divided by the known root (no
 /// isolation), unless that is a close call. Empty when the cubic is degenerate.
+#[inline(always)]
 fn other_roots(g: &ModuleGeometry, p: &Vector3<f64>, certified: Option<Leg1>) -> ArrayVec<f64, 8> {
     let all_roots = |lo: f64, hi: f64| match cubic_eq9(g, p) {
         Some(coeffs) => cubic_roots_in(&coeffs, lo, hi)
@@ -119,6 +120,7 @@ fn other_roots(g: &ModuleGeometry, p: &Vector3<f64>, certified: Option<Leg1>) ->
 /// half-sum and half-difference of (3) and (4)), then the certified one; each with its mirror
 /// image, or where sin(alpha) = 0 both signs of eq. (11) (Table II). A posture met before is
 /// left out.
+#[inline(always)]
 fn leg1_postures_into(
     g: &ModuleGeometry,
     p: &Vector3<f64>,
@@ -163,8 +165,8 @@ fn leg1_postures_into(
             }
             continue;
         }
-        // sgn(rho1 - zp) from eq. (14): y (R1 cos a - r1) = R1 sin a (rho1 - zp).
-        let q = p.y * (r * c - rr) / (r * sin_a);
+        // sgn(rho1 - zp) from eq. (14): y (R1 cos a - r1) = R1 sin a (rho1 - zp), R1 sin a > 0.
+        let q = p.y * (r * c - rr);
         let rho1 = if q == 0.0 { p.z } else { p.z + q.signum() * h };
         let polished = polish_leg1(
             g,
@@ -208,6 +210,7 @@ const PREDICTED_STEP_FRACTION: f64 = 1e-3;
 /// Newton's last or next step below [`NEWTON_STEP_STOP`]); the best posture met when it runs
 /// out of iterations or meets a singular Jacobian. The result carries the sin and cos of its
 /// alpha.
+#[inline(always)]
 fn polish_leg1(g: &ModuleGeometry, p: &Vector3<f64>, start: Leg1) -> Leg1 {
     let eqs = Leg1Equations::new(g, p);
     let amax = |f: [f64; 2]| f[0].abs().max(f[1].abs());
