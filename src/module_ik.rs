@@ -583,13 +583,12 @@ fn branches_into(m: &Machine, p: &Vector3<f64>, legs1: &ArrayVec<Leg1, 6>, out: 
     }
     for &k in order.iter() {
         if let Some(o) = &outer[k] {
-            for b in four_branches(m, p, &legs1[k], checks[k], o) {
-                let pushed = out.try_push(b);
-                debug_assert!(
-                    pushed.is_ok(),
-                    "six postures of four branches fit MAX_IK_BRANCHES"
-                );
-            }
+            let four = four_branches(m, p, &legs1[k], checks[k], o);
+            let pushed = out.try_extend_from_slice(&four);
+            debug_assert!(
+                pushed.is_ok(),
+                "six postures of four branches fit MAX_IK_BRANCHES"
+            );
         }
     }
 }
