@@ -597,7 +597,7 @@ fn branches_into(m: &Machine, p: &Vector3<f64>, legs1: &ArrayVec<Leg1, 6>, out: 
 /// and its mirror image share them): the square roots of eqs. (12)-(13) and each root's label
 /// and verdict but the stroke.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct OuterLegs {
+struct OuterLegs {
     /// sqrt(L2^2 - (xp + D2 - d2)^2 - (yp - R2 cos a + r4)^2) and its eq. (13) counterpart.
     h: [f64; 2],
     /// [leg II, leg III][lower root, upper root].
@@ -606,12 +606,7 @@ pub(crate) struct OuterLegs {
 
 /// [`OuterLegs`] of `p` at cos(alpha) = `c`; None when leg II or III cannot reach.
 #[inline(always)]
-pub(crate) fn outer_legs(
-    m: &Machine,
-    p: &Vector3<f64>,
-    c: f64,
-    cos_tilt: f64,
-) -> Option<OuterLegs> {
+fn outer_legs(m: &Machine, p: &Vector3<f64>, c: f64, cos_tilt: f64) -> Option<OuterLegs> {
     let g = &m.module;
     let dx2 = p.x + g.dx2;
     // eq. (12): rho2 = zp - R2 sin a + s2 sqrt(L2^2 - (xp + D2 - d2)^2 - (yp - R2 cos a + r4)^2)
