@@ -159,10 +159,8 @@ impl LegState {
             bit(
                 self.sign() != -1,
                 Reason::Leg1Inverted as u16 + self.leg as u16,
-            ) | bit(
-                self.outside_stroke,
-                Reason::Rho1Stroke as u16 + self.leg as u16,
-            ) | bit(self.tilted, Reason::RodTilt as u16),
+            ) | stroke_bit(self.leg, self.outside_stroke)
+                | bit(self.tilted, Reason::RodTilt as u16),
         )
     }
 
@@ -298,7 +296,13 @@ fn outer_leg_pair(
 /// The stroke reason of slider `leg` (0, 1, 2) at `rho_i`, when it is outside its stroke.
 #[inline]
 pub fn stroke_verdict(m: &Machine, leg: usize, rho_i: f64) -> Verdict {
-    Verdict((outside_stroke(m, leg, rho_i) as u16) << (Reason::Rho1Stroke as u16 + leg as u16))
+    Verdict(stroke_bit(leg, outside_stroke(m, leg, rho_i)))
+}
+
+/// The bit of leg `leg`'s stroke reason (Rho1Stroke + leg in [`Reason`]'s order) when `on`.
+#[inline]
+fn stroke_bit(leg: usize, on: bool) -> u16 {
+    (on as u16) << (Reason::Rho1Stroke as u16 + leg as u16)
 }
 
 /// cos of the largest rod tilt with its slack, for [`leg_state`].
