@@ -235,10 +235,11 @@ impl Trig {
     ///
     /// Complete by construction: F, F', F'' are sampled on a grid of 32 points and every grid
     /// interval is either proved root-free, proved monotone (its one root, if F changes sign, is
-    /// found by bracketed Newton), proved convex or concave (split at its critical point into two
-    /// monotone pieces), or bisected (see `Isolation::interval`). This replaces the degree-8
-    /// half-angle polynomials of IFToMM 2007 section VI for the forward kinematics (one pass over
-    /// the circle, no chart at alpha = pi, no recursion on derivatives).
+    /// found by bracketed Chebyshev steps, Newton's corrected by F''), proved convex or concave
+    /// (split at its critical point into two monotone pieces), or bisected (see
+    /// `Isolation::interval`). This replaces the degree-8 half-angle polynomials of IFToMM 2007
+    /// section VI for the forward kinematics (one pass over the circle, no chart at alpha = pi,
+    /// no recursion on derivatives).
     pub fn roots(&self) -> ArrayVec<f64, MAX_TRIG_ROOTS> {
         self.roots_sin_cos().iter().map(|r| r.x).collect()
     }
@@ -430,7 +431,7 @@ impl Isolation {
         self.at_sc(x, s1, c1)
     }
 
-    /// sin and cos of x along a Newton iteration: from those of the previous point when it is
+    /// sin and cos of x along a root iteration: from those of the previous point when it is
     /// close ([`sin_cos_after_step`]), kept in `last`.
     #[inline(always)]
     fn sin_cos_following(x: f64, last: &std::cell::Cell<Option<(f64, f64, f64)>>) -> (f64, f64) {
@@ -442,14 +443,14 @@ impl Isolation {
         (s1, c1)
     }
 
-    /// [`Isolation::at`] along a Newton iteration ([`Isolation::sin_cos_following`]).
+    /// [`Isolation::at`] along a root iteration ([`Isolation::sin_cos_following`]).
     #[inline]
     fn at_following(&self, x: f64, last: &std::cell::Cell<Option<(f64, f64, f64)>>) -> Pt {
         let (s1, c1) = Self::sin_cos_following(x, last);
         self.at_sc(x, s1, c1)
     }
 
-    /// g and h (two of F, F', F'') at x along a Newton iteration, without the third.
+    /// g and h (two of F, F', F'') at x along a root iteration, without the third.
     #[inline(always)]
     fn pair_following(
         x: f64,
@@ -569,8 +570,13 @@ impl Isolation {
         if opposite_beyond(a.f, b.f, self.ef) {
             let start = root_start(a, b);
             let last = std::cell::Cell::new(Some((a.x, a.sin, a.cos)));
-            let x = newton_bracketed(a.x, b.x, a.f, start, self.m2, |x| {
-                Self::pair_following(x, &last, &self.f, &self.d)
+            let bounds = StepBounds {
+                m2: self.m2,
+                m3: Some(self.m3),
+            };
+            let x = newton_bracketed(a.x, b.x, a.f, start, bounds, |x| {
+                let p = self.at_following(x, &last);
+                (p.f, p.d, p.s)
             });
             self.push(x, Self::sin_cos_following(x, &last));
         }
@@ -580,8 +586,13 @@ impl Isolation {
     fn critical(&self, a: Pt, b: Pt) -> Pt {
         let start = hermite_start(a.x, b.x, a.d, b.d, a.s, b.s);
         let last = std::cell::Cell::new(Some((a.x, a.sin, a.cos)));
-        let x = newton_bracketed(a.x, b.x, a.d, start, self.m3, |x| {
-            Self::pair_following(x, &last, &self.d, &self.s)
+        let bounds = StepBounds {
+            m2: self.m3,
+            m3: None,
+        };
+        let x = newton_bracketed(a.x, b.x, a.d, start, bounds, |x| {
+            let (g, dg) = Self::pair_following(x, &last, &self.d, &self.s);
+            (g, dg, 0.0)
         });
         self.at_following(x, &last)
     }
@@ -655,22 +666,33 @@ fn hermite_start(a: f64, b: f64, ga: f64, gb: f64, da: f64, db: f64) -> f64 {
     if x > a && x < b { x } else { 0.5 * (a + b) }
 }
 
-/// The single root of g, monotone on [a, b] and changing sign there (g(a) = ga), by Newton steps
-/// kept inside a shrinking bracket (bisection when a step leaves it), from `start`. `m2` bounds
-/// |g''|: a Newton step dx from x leaves an error of at most m2 dx^2 / (2 |g'|), so iteration
-/// stops once that (or the step itself) is below the rounding of x, or the bracket cannot shrink.
+/// Bounds on the derivatives of g over the circle for [`newton_bracketed`]: `m2` on |g''|, and
+/// `m3` on |g'''| when g'' is evaluated too (Chebyshev's steps).
+#[derive(Debug, Clone, Copy)]
+struct StepBounds {
+    m2: f64,
+    m3: Option<f64>,
+}
+
+/// The single root of g, monotone on [a, b] and changing sign there (g(a) = ga), from `start`, by
+/// steps kept inside a shrinking bracket (bisection when a step leaves it). `eval` gives g, g' and
+/// g'' (used only with `bounds.m3`). With d = g / g' the Newton step, the step taken is Newton's,
+/// x - d, which leaves an error of at most m2 d^2 / (2 |g'|); or, with g'', Chebyshev's,
+/// x - d - g'' d^2 / (2 g'), which leaves at most (m2^2 / (2 g'^2) + m3 / (6 |g'|)) |d|^3 (the
+/// e^3 term of its expansion about the root): the iteration stops once that (or the step itself)
+/// is below the rounding of x, or the bracket cannot shrink.
 fn newton_bracketed(
     mut a: f64,
     mut b: f64,
     ga: f64,
     start: f64,
-    m2: f64,
-    eval: impl Fn(f64) -> (f64, f64),
+    bounds: StepBounds,
+    eval: impl Fn(f64) -> (f64, f64, f64),
 ) -> f64 {
     let a_neg = ga < 0.0;
     let mut x = start;
     for _ in 0..200 {
-        let (g, dg) = eval(x);
+        let (g, dg, ddg) = eval(x);
         if g == 0.0 {
             return x;
         }
@@ -680,10 +702,21 @@ fn newton_bracketed(
             b = x;
         }
         let step = g / dg;
-        let next = x - step;
+        let (next, left) = match bounds.m3 {
+            None => (x - step, bounds.m2 * step * step / (2.0 * dg.abs())),
+            Some(m3) => {
+                let inv = 1.0 / dg;
+                let q = bounds.m2 * inv;
+                let step2 = step * step;
+                (
+                    x - step - 0.5 * ddg * inv * step2,
+                    (0.5 * q * q + m3 * inv.abs() * (1.0 / 6.0)) * (step2 * step).abs(),
+                )
+            }
+        };
         if next > a && next < b {
             let tol = f64::EPSILON * next.abs().max(1e-3);
-            if step.abs() <= tol || m2 * step * step <= tol * 2.0 * dg.abs() {
+            if step.abs() <= tol || left <= tol {
                 return next;
             }
             x = next;
