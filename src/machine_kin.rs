@@ -341,12 +341,25 @@ fn theta1_in_limits(m: &Machine, theta1: f64) -> bool {
 /// theta1 roots come from a certified isolation).
 pub fn machine_ik(m: &Machine, pose: &ToolPose, tool_length: f64) -> MachineIkBranches {
     let mut out = MachineIkBranches::new();
+    machine_ik_into(m, pose, tool_length, &mut out);
+    out
+}
+
+/// [`machine_ik`] into an existing list (cleared first), so that a caller that keeps one does
+/// not copy it.
+pub fn machine_ik_into(
+    m: &Machine,
+    pose: &ToolPose,
+    tool_length: f64,
+    out: &mut MachineIkBranches,
+) {
+    out.clear();
     let finite = pose.tip.iter().all(|v| v.is_finite())
         && pose.phi1.is_finite()
         && pose.phi2.is_finite()
         && tool_length.is_finite();
     if !finite {
-        return out;
+        return;
     }
     let g = &m.module;
     let (r, rr) = (g.r_big1, g.r_small1);
@@ -381,7 +394,7 @@ pub fn machine_ik(m: &Machine, pose: &ToolPose, tool_length: f64) -> MachineIkBr
         }
     }
     let mut pairs: ArrayVec<PathPoint, MAX_THETA1_SOLUTIONS> = ArrayVec::new();
-    for (root, at_alpha_zero) in seeds {
+    for &(root, at_alpha_zero) in &seeds {
         let seed = |rho1: f64| PathPoint {
             theta1: root.x,
             sin: root.sin,
@@ -420,9 +433,9 @@ pub fn machine_ik(m: &Machine, pose: &ToolPose, tool_length: f64) -> MachineIkBr
     }
     let theta2 = wrap_angle(-pose.phi2);
     let cos_tilt = cos_tilt_max(m);
-    for q in pairs {
+    for q in &pairs {
         let (p, _) = platform_at(m.table.d_a, &path.w, q.sin, q.cos);
-        let (sin, cos) = path.alpha_sin_cos(&q);
+        let (sin, cos) = path.alpha_sin_cos(q);
         let leg1 = Leg1 {
             alpha: wrap_angle(q.theta1 + pose.phi1),
             rho1: q.rho1,
@@ -460,7 +473,6 @@ pub fn machine_ik(m: &Machine, pose: &ToolPose, tool_length: f64) -> MachineIkBr
         }
     }
     out.sort_by(|a, b| a.theta1.total_cmp(&b.theta1).then(a.config.cmp(&b.config)));
-    out
 }
 
 /// Every assembly mode of the machine for the joints (AIM 2007, section III.D): the module's
@@ -641,6 +653,24 @@ pub fn path_candidates(
     prev_theta2: Option<f64>,
 ) -> Result<PathCandidates, PathError> {
     let mut out = PathCandidates::default();
+    path_candidates_into(m, tip, orientation, tool_length, prev_theta2, &mut out)?;
+    Ok(out)
+}
+
+/// [`path_candidates`] into an existing set (cleared first), so that a caller that keeps one (a
+/// batch's row) does not copy it; on error the set is left empty.
+pub fn path_candidates_into(
+    m: &Machine,
+    tip: &Vector3<f64>,
+    orientation: &ToolOrientation,
+    tool_length: f64,
+    prev_theta2: Option<f64>,
+    out: &mut PathCandidates,
+) -> Result<(), PathError> {
+    out.options.clear();
+    out.all.clear();
+    out.near_singular = false;
+    out.needs_previous = false;
     match orientation {
         ToolOrientation::Angles(a) => {
             out.near_singular = a.phi1.sin().abs() < crate::orientation::ROTARY_SINGULAR_CONE_RAD;
@@ -652,9 +682,9 @@ pub fn path_candidates(
                 out.options.push((sols[1], 2));
             }
             AxisAngles::NearRotary { .. } => {
+                let a = unit_axis(v).map_err(PathError::Axis)?;
                 out.near_singular = true;
                 out.needs_previous = true;
-                let a = unit_axis(v).map_err(PathError::Axis)?;
                 let phi2 = -prev_theta2.unwrap_or(0.0);
                 out.options.push((
                     ToolAngles {
@@ -666,13 +696,15 @@ pub fn path_candidates(
             }
         },
     }
+    let mut branches = MachineIkBranches::new();
     for &(angles, label) in &out.options {
         let pose = ToolPose {
             tip: *tip,
             phi1: angles.phi1,
             phi2: angles.phi2,
         };
-        for branch in machine_ik(m, &pose, tool_length) {
+        machine_ik_into(m, &pose, tool_length, &mut branches);
+        for &branch in &branches {
             out.all.push(Candidate {
                 branch,
                 angles,
@@ -681,7 +713,7 @@ pub fn path_candidates(
             });
         }
     }
-    Ok(out)
+    Ok(())
 }
 
 impl PathState {
@@ -714,44 +746,40 @@ impl PathState {
     pub fn choose(&mut self, candidates: &PathCandidates) -> Result<PathRow, PathError> {
         let options = &candidates.options;
         let near_singular = candidates.near_singular;
-        // theta2 unwrapped next to the previous row's; every branch of an orientation solution
-        // has the same theta2, so each value is unwrapped once (an `fmod` once the rotary axis
-        // has turned more than once).
-        let mut unwrapped = ArrayVec::<(u64, f64), 2>::new();
-        let mut unwrap = |t: f64| {
-            let Some(p) = self.prev else {
-                return t;
-            };
-            if let Some(&(_, u)) = unwrapped.iter().find(|(bits, _)| *bits == t.to_bits()) {
-                return u;
-            }
-            let u = unwrap_near(t, p.theta2);
-            if !unwrapped.is_full() {
-                unwrapped.push((t.to_bits(), u));
-            }
-            u
-        };
-        let all: ArrayVec<Candidate, { 2 * MAX_MACHINE_IK_BRANCHES }> = candidates
-            .all
+        // theta2 unwrapped next to the previous row's, once per orientation solution (every
+        // branch of one has the same theta2; an `fmod` once the rotary axis has turned more than
+        // once); the candidates are read with it, not copied.
+        let unwrapped: ArrayVec<(u8, f64), 2> = options
             .iter()
-            .map(|c| Candidate {
-                theta2: unwrap(c.theta2),
-                ..*c
+            .map(|&(angles, label)| {
+                let t = wrap_angle(-angles.phi2);
+                (label, self.prev.map_or(t, |p| unwrap_near(t, p.theta2)))
             })
             .collect();
+        let theta2 = |c: &Candidate| {
+            unwrapped
+                .iter()
+                .find(|(label, _)| *label == c.orientation)
+                .map_or(c.theta2, |&(_, t)| t)
+        };
+        let with_unwrapped = |c: &Candidate| Candidate {
+            theta2: theta2(c),
+            ..*c
+        };
+        let all = &candidates.all;
         let machine_kind = |c: &&Candidate| c.branch.working() || c.branch.verdict.only_limits();
         let (chosen, switched) = match self.prev {
             Some(prev) => {
                 let dist = |c: &Candidate| {
                     (c.branch.rho - prev.rho).amax() / JOINT_DISTANCE_MM_PER_RAD
                         + (c.branch.theta1 - prev.theta1).abs()
-                        + (c.theta2 - prev.theta2).abs()
+                        + (theta2(c) - prev.theta2).abs()
                 };
                 let nearest = |ok: &dyn Fn(&Candidate) -> bool| {
                     all.iter()
                         .filter(|c| ok(c))
                         .min_by(|a, b| dist(a).total_cmp(&dist(b)))
-                        .copied()
+                        .map(with_unwrapped)
                 };
                 let continuation = nearest(&|c| machine_kind(&c));
                 match continuation {
@@ -772,7 +800,7 @@ impl PathState {
                     all.iter()
                         .filter(|c| ok(c))
                         .min_by(|a, b| a.branch.theta1.abs().total_cmp(&b.branch.theta1.abs()))
-                        .copied()
+                        .map(with_unwrapped)
                 };
                 let wanted = match self.first {
                     FirstRowChoice::SmallestTheta1 => None,

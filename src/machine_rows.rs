@@ -1,13 +1,14 @@
 //! The whole 5-axis machine as row jobs (`verne ik` on tool poses, `verne fk` on five joints):
 //! tool tip and axis in the workpiece frame <-> (rho1, rho2, rho3, theta1, theta2).
 
+use arrayvec::ArrayVec;
 use nalgebra::Vector3;
 
 use crate::error::VerneError;
 use crate::machine::Machine;
 use crate::machine_kin::{
-    FirstRowChoice, MachineFkModes, PathCandidates, PathError, PathState, machine_fk,
-    path_candidates,
+    FirstRowChoice, MAX_MACHINE_IK_BRANCHES, MachineFkModes, PathCandidates, PathError, PathState,
+    machine_fk, path_candidates, path_candidates_into,
 };
 use crate::module_geometry::Sliders;
 use crate::module_rows::emit_branches;
@@ -112,12 +113,15 @@ const IK_OUT_ALL: &[&str] = &[
 ];
 
 /// One row's solve result: the tip and orientation read, and the candidates computed with no
-/// previous row (recomputed in order when the axis is inside the rotary cone).
+/// previous row (recomputed in order when the axis is inside the rotary cone), kept from row to
+/// row and refilled in place.
 #[derive(Default)]
 pub struct SolvedToolPose {
     tip: Vector3<f64>,
     orientation: Option<ToolOrientation>,
-    candidates: Option<Result<PathCandidates, PathError>>,
+    candidates: PathCandidates,
+    /// None until the row is solved; the error when it has no candidates.
+    outcome: Option<Result<(), PathError>>,
 }
 
 impl MachineIk {
@@ -153,12 +157,13 @@ impl RowJob for MachineIk {
         let orientation = self.orientation_of(inputs);
         solved.tip = tip;
         solved.orientation = Some(orientation);
-        solved.candidates = Some(path_candidates(
+        solved.outcome = Some(path_candidates_into(
             &self.machine,
             &tip,
             &orientation,
             self.tool_length,
             None,
+            &mut solved.candidates,
         ));
     }
 
@@ -167,11 +172,12 @@ impl RowJob for MachineIk {
         solved: &SolvedToolPose,
         out: &mut RowWriter<'_>,
     ) -> Result<RowOutcome, VerneError> {
-        let Some(candidates) = &solved.candidates else {
+        let Some(outcome) = &solved.outcome else {
             return Err(VerneError::Usage(
                 "internal: row emitted before it was solved".into(),
             ));
         };
+        let candidates = outcome.as_ref().map(|()| &solved.candidates);
         let recomputed;
         let candidates = match (candidates, solved.orientation, self.state.previous()) {
             (Ok(c), Some(o), Some(prev)) if c.needs_previous() && !self.all => {
@@ -182,7 +188,7 @@ impl RowJob for MachineIk {
                     self.tool_length,
                     Some(prev.theta2),
                 );
-                &recomputed
+                recomputed.as_ref()
             }
             _ => candidates,
         };
@@ -191,7 +197,8 @@ impl RowJob for MachineIk {
             Err(e) => return bad_row(out, e, self.all),
         };
         if self.all {
-            let branches: Vec<_> = candidates.iter().collect();
+            let branches: ArrayVec<_, { 2 * MAX_MACHINE_IK_BRANCHES }> =
+                candidates.iter().collect();
             return emit_branches(out, true, &branches, None, |(b, orientation, theta2)| {
                 let values = [
                     Cell::Int((*orientation).into()),
@@ -249,9 +256,11 @@ fn bad_row(out: &mut RowWriter<'_>, e: &PathError, all: bool) -> Result<RowOutco
     } else {
         IK_OUT_PATH.len()
     };
-    let mut cells = vec![Cell::Empty; n];
+    // The longer of the two layouts holds either.
+    const _: () = assert!(IK_OUT_PATH.len() <= IK_OUT_ALL.len());
+    let mut cells = [Cell::Empty; IK_OUT_ALL.len()];
     cells[n - 1] = status;
-    out.row(&cells)?;
+    out.row(&cells[..n])?;
     Ok(RowOutcome { ok: false, status })
 }
 

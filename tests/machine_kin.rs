@@ -10,7 +10,8 @@ use std::f64::consts::{FRAC_PI_6, PI, TAU};
 use nalgebra::{Matrix4, Vector3, Vector4};
 use verne::machine::Machine;
 use verne::machine_kin::{
-    FirstRowChoice, PathState, ToolPose, machine_fk, machine_ik, theta1_equation, tool_pose_eq26,
+    FirstRowChoice, PathCandidates, PathState, ToolPose, machine_fk, machine_ik, path_candidates,
+    path_candidates_into, theta1_equation, tool_pose_eq26,
 };
 use verne::module_geometry::{ModulePose, jacobian_pose, jacobian_sliders};
 use verne::module_ik::wrap_angle;
@@ -631,4 +632,50 @@ fn first_row_preference_and_unreachable_rows() {
         )
         .unwrap_err();
     assert!(bad.to_string().contains("length 3"), "{bad}");
+}
+
+#[test]
+fn candidates_refilled_in_place_are_the_fresh_ones() {
+    // One set refilled row after row (as `verne ik` keeps one per batch row) gives what a fresh
+    // one gives, through an invalid axis, the rotary cone, an unreachable tip and given angles.
+    let m = Machine::default_verne();
+    let tip = Vector3::new(-50.0, 10.0, 50.0);
+    let rows = [
+        (
+            tip,
+            ToolOrientation::Axis(Vector3::new(0.0, 0.2f64.sin(), 0.2f64.cos())),
+        ),
+        (tip, ToolOrientation::Axis(Vector3::new(0.0, 0.0, 3.0))),
+        (tip, ToolOrientation::Axis(Vector3::new(1e-7, 0.0, 1.0))),
+        (
+            Vector3::new(-50.0, 10.0, 900.0),
+            ToolOrientation::Axis(Vector3::z()),
+        ),
+        (
+            tip,
+            ToolOrientation::Angles(verne::orientation::ToolAngles {
+                phi1: 0.3,
+                phi2: -1.2,
+            }),
+        ),
+        (tip, ToolOrientation::Axis(Vector3::new(0.3, -0.1, 0.9))),
+    ];
+    let mut reused = PathCandidates::default();
+    for prev_theta2 in [None, Some(2.5)] {
+        for (tip, o) in &rows {
+            let fresh = path_candidates(&m, tip, o, DELTA, prev_theta2);
+            let refilled = path_candidates_into(&m, tip, o, DELTA, prev_theta2, &mut reused);
+            match (fresh, refilled) {
+                (Ok(f), Ok(())) => {
+                    assert_eq!(f.needs_previous(), reused.needs_previous());
+                    assert!(f.iter().eq(reused.iter()), "{tip:?} {o:?}");
+                }
+                (Err(f), Err(r)) => {
+                    assert_eq!(f.to_string(), r.to_string());
+                    assert!(reused.is_empty());
+                }
+                (f, r) => panic!("{tip:?} {o:?}: fresh {:?}, refilled {r:?}", f.err()),
+            }
+        }
+    }
 }
