@@ -35,7 +35,9 @@ use verne::branches::{Config, config_of, module_verdict};
 use verne::cubic::cubic_roots_in;
 use verne::fk_track::FkTracker;
 use verne::machine::{Machine, ModuleGeometry};
-use verne::machine_kin::{FirstRowChoice, PathState, machine_fk, path_candidates};
+use verne::machine_kin::{
+    FirstRowChoice, PathCandidates, PathState, machine_fk, path_candidates, path_candidates_into,
+};
 use verne::module_fk::{self, FkModes};
 use verne::module_geometry::{
     ModulePose, Sliders, jacobian_pose, jacobian_sliders, polish_pose, residuals,
@@ -642,20 +644,23 @@ impl Fixture {
     }
 
     /// Every branch of every tool pose of the machine path, over both orientation solutions of
-    /// the axis (what `verne machine ik` solves per row before choosing).
+    /// the axis (what `verne ik` solves per row of tool poses before choosing), into one set
+    /// refilled row after row as the streaming engine refills a batch row's.
     fn run_machine_ik(&self) -> usize {
         let tl = self.machine.tool_length;
+        let mut candidates = PathCandidates::default();
         self.tool_path
             .iter()
             .map(|t| {
-                path_candidates(
+                path_candidates_into(
                     &self.machine,
                     black_box(&t.tip),
                     &ToolOrientation::Axis(t.axis),
                     tl,
                     None,
+                    &mut candidates,
                 )
-                .map_or(0, |c| c.len())
+                .map_or(0, |()| candidates.len())
             })
             .sum()
     }
@@ -994,7 +999,7 @@ const KERNELS: &[(&str, &str, &str, &str)] = &[
         "machine/ik_all_branches",
         "tool pose",
         "",
-        "tip + axis -> every branch, both orientation solutions (path_candidates)",
+        "tip + axis -> every branch, both orientation solutions (path_candidates_into)",
     ),
     (
         "machine/fk_all_modes",

@@ -44,7 +44,7 @@ use crate::tolerance::{
     ACCEPT_RESIDUAL_MM, LIMIT_SLACK, NEWTON_MAX_ITER, NEWTON_STEP_STOP, SAME_SOLUTION_MM,
     SAME_SOLUTION_RAD,
 };
-use crate::trig::{MAX_TRIG_ROOTS, Trig, TrigRoot, sin_cos_after_step};
+use crate::trig::{Trig, TrigRoot, sin_cos_after_step};
 
 /// |sin(alpha)| (dimensionless) below which both signs of rho1 - zp are tried at a root of F:
 /// there F has a double root or two very close ones and the sign from eq. (14) is unreliable.
@@ -377,24 +377,25 @@ pub fn machine_ik_into(
     // where F is clearly positive there, the roots nearby are simple and isolated (and with
     // sin(alpha) that small both signs are tried anyway). Elsewhere the sign comes from eq. (14),
     // even at a double root of F (a tangency, where it is still defined).
-    let mut seeds: ArrayVec<(TrigRoot, bool), { MAX_TRIG_ROOTS + 2 }> = f
-        .roots_sin_cos()
-        .into_iter()
-        .map(|root| (root, false))
-        .collect();
+    let roots = f.roots_sin_cos();
     let f_scale = f
         .cos
         .iter()
         .chain(&f.sin)
         .fold(0.0f64, |m, a| m.max(a.abs()));
+    let mut alpha_zero_seeds = ArrayVec::<TrigRoot, 2>::new();
     for th in [-pose.phi1, PI - pose.phi1] {
         let (sin, cos) = th.sin_cos();
         if f.eval_sc(sin, cos) <= ALPHA_ZERO_SEED_REL * f_scale {
-            seeds.push((TrigRoot { x: th, sin, cos }, true));
+            alpha_zero_seeds.push(TrigRoot { x: th, sin, cos });
         }
     }
+    let seeds = roots
+        .iter()
+        .map(|root| (*root, false))
+        .chain(alpha_zero_seeds.iter().map(|root| (*root, true)));
     let mut pairs: ArrayVec<PathPoint, MAX_THETA1_SOLUTIONS> = ArrayVec::new();
-    for &(root, at_alpha_zero) in &seeds {
+    for (root, at_alpha_zero) in seeds {
         let seed = |rho1: f64| PathPoint {
             theta1: root.x,
             sin: root.sin,
