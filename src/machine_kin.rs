@@ -473,7 +473,16 @@ pub fn machine_ik_into(
             }
         }
     }
-    out.sort_by(|a, b| a.theta1.total_cmp(&b.theta1).then(a.config.cmp(&b.config)));
+    // Usually in order already (roots by increasing theta1, a posture's four branches by
+    // (s2, s3)): checked with plain comparisons (a theta1 below the next, or the same bits and a
+    // configuration no larger: what the sort's comparison says), sorted only otherwise.
+    let in_order = out.windows(2).all(|w| {
+        w[0].theta1 < w[1].theta1
+            || (w[0].theta1.to_bits() == w[1].theta1.to_bits() && w[0].config <= w[1].config)
+    });
+    if !in_order {
+        out.sort_by(|a, b| a.theta1.total_cmp(&b.theta1).then(a.config.cmp(&b.config)));
+    }
 }
 
 /// Every assembly mode of the machine for the joints (AIM 2007, section III.D): the module's

@@ -271,6 +271,17 @@ fn pose_grid() -> Vec<ToolPose> {
     out
 }
 
+/// Branches in the documented order: by theta1, then by configuration.
+fn assert_ordered(ik: &[verne::machine_kin::MachineIkBranch], pose: &ToolPose) {
+    for w in ik.windows(2) {
+        let order = w[0]
+            .theta1
+            .total_cmp(&w[1].theta1)
+            .then(w[0].config.cmp(&w[1].config));
+        assert!(order.is_le(), "{pose:?}: {:?} before {:?}", w[0], w[1]);
+    }
+}
+
 #[test]
 fn fk_of_every_ik_branch_returns_the_pose() {
     let m = Machine::default_verne();
@@ -282,6 +293,7 @@ fn fk_of_every_ik_branch_returns_the_pose() {
     let mut ill_conditioned = 0;
     for pose in &grid {
         let ik = machine_ik(&m, pose, DELTA);
+        assert_ordered(&ik, pose);
         if ik.iter().any(|b| b.working()) {
             with_working += 1;
         }
@@ -504,6 +516,7 @@ fn near_double_roots_at_alpha_zero_keep_both_postures() {
                     phi2: 0.0,
                 };
                 let ik = machine_ik(&m, &pose, DELTA);
+                assert_ordered(&ik, &pose);
                 for th in [-phi1, PI - phi1] {
                     let mut rho1: Vec<f64> = ik
                         .iter()
