@@ -283,11 +283,22 @@ impl Trig {
             d: d.at_grid(j % GRID),
             s: s.at_grid(j % GRID),
         };
+        // Intervals that F alone does not prove root-free, as a bit mask: bit j of `above`
+        // (`below`) when F(x_j) is beyond the bound above (below) zero, and interval j (x_j to
+        // x_j+1, around the circle) proved root-free when both its ends are. F is finite on
+        // the grid, so these plain comparisons say what `same_sign_beyond` says.
         let root_free = step * step * 0.125 * iso.m2 + iso.ef;
-        for j in 0..GRID {
-            if same_sign_beyond(fv[j], fv[(j + 1) % GRID], root_free) {
-                continue;
-            }
+        const _: () = assert!(GRID == u32::BITS as usize);
+        let (mut above, mut below) = (0u32, 0u32);
+        for (j, v) in fv.iter().enumerate() {
+            above |= u32::from(*v > root_free) << j;
+            below |= u32::from(*v < -root_free) << j;
+        }
+        let free = (above & above.rotate_right(1)) | (below & below.rotate_right(1));
+        let mut undecided = !free;
+        while undecided != 0 {
+            let j = undecided.trailing_zeros() as usize;
+            undecided &= undecided - 1;
             let (a, b) = (pt(j), pt(j + 1));
             let found = iso.out.len();
             let near_zero = a.f.abs() <= iso.ef || b.f.abs() <= iso.ef;
