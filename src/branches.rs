@@ -316,6 +316,16 @@ pub fn combine(m: &Machine, c: f64, legs: [Verdict; 3]) -> Verdict {
     legs[0].with(legs[1]).with(legs[2]).with(rods_cross(m, c))
 }
 
+/// Whether two branches keyed (angle, configuration) are listed as the sort by the angle's
+/// `total_cmp`, then the configuration, lists them: the angle below the next, or the same bits
+/// and a configuration no larger. Plain comparisons, to check a list that is usually in order
+/// already before sorting it (a pair it cannot vouch for, such as -0 before +0, only sends the
+/// list to the sort).
+#[inline]
+pub fn listed_in_order<K: PartialOrd>((a, key_a): (f64, K), (b, key_b): (f64, K)) -> bool {
+    a < b || (a.to_bits() == b.to_bits() && key_a <= key_b)
+}
+
 /// [`Reason::RodsCross`] when R1 cos(alpha) <= r1, else nothing.
 #[inline]
 pub fn rods_cross(m: &Machine, c: f64) -> Verdict {

@@ -33,7 +33,7 @@ use std::f64::consts::PI;
 use arrayvec::ArrayVec;
 use nalgebra::{Matrix2, Matrix4, Vector2, Vector3, Vector4};
 
-use crate::branches::{Config, Reason, Verdict, cos_tilt_max, leg_state};
+use crate::branches::{Config, Reason, Verdict, cos_tilt_max, leg_state, listed_in_order};
 use crate::machine::{Machine, TableGeometry};
 use crate::module_geometry::{ModulePose, Sliders, residual_mm_sc};
 use crate::module_ik::{Leg1, posture_branches, wrap_angle};
@@ -474,12 +474,10 @@ pub fn machine_ik_into(
         }
     }
     // Usually in order already (roots by increasing theta1, a posture's four branches by
-    // (s2, s3)): checked with plain comparisons (a theta1 below the next, or the same bits and a
-    // configuration no larger: what the sort's comparison says), sorted only otherwise.
-    let in_order = out.windows(2).all(|w| {
-        w[0].theta1 < w[1].theta1
-            || (w[0].theta1.to_bits() == w[1].theta1.to_bits() && w[0].config <= w[1].config)
-    });
+    // (s2, s3)): sorted only when that check fails.
+    let in_order = out
+        .windows(2)
+        .all(|w| listed_in_order((w[0].theta1, w[0].config), (w[1].theta1, w[1].config)));
     if !in_order {
         out.sort_by(|a, b| a.theta1.total_cmp(&b.theta1).then(a.config.cmp(&b.config)));
     }

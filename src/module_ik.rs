@@ -14,8 +14,8 @@ use arrayvec::ArrayVec;
 use nalgebra::Vector3;
 
 use crate::branches::{
-    Config, Verdict, WORKING_CONFIG, cos_tilt_max, leg_state, outer_leg_labels, outer_leg_states,
-    rods_cross, stroke_verdict,
+    Config, Verdict, WORKING_CONFIG, cos_tilt_max, leg_state, listed_in_order, outer_leg_labels,
+    outer_leg_states, rods_cross, stroke_verdict,
 };
 use crate::cubic::{cubic_roots_in, deflated_roots_in};
 use crate::machine::{Machine, ModuleGeometry};
@@ -567,12 +567,11 @@ fn branches_into(m: &Machine, p: &Vector3<f64>, legs1: &ArrayVec<Leg1, 6>, out: 
         }
     }
     let order = &mut order[..n];
-    // In order when each alpha is below the next, or the same (bit for bit) with s1 no larger:
-    // what the sort's comparison says, without it.
     let in_order = order.windows(2).all(|w| {
-        let (a, b) = (&legs1[w[0]], &legs1[w[1]]);
-        a.alpha < b.alpha
-            || (a.alpha.to_bits() == b.alpha.to_bits() && checks[w[0]].0 <= checks[w[1]].0)
+        listed_in_order(
+            (legs1[w[0]].alpha, checks[w[0]].0),
+            (legs1[w[1]].alpha, checks[w[1]].0),
+        )
     });
     if !in_order {
         let key = |k: usize| (legs1[k].alpha, checks[k].0);
