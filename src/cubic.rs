@@ -134,9 +134,11 @@ const DEFLATED_END_MARGIN: f64 = 1e-9;
 /// (outside [lo, hi]): the quadratic c / (x - w) in closed form, sorted. None when that is a close
 /// call (a discriminant near zero: a close pair or double root; a root near `lo` or `hi`), so
 /// that [`cubic_roots_in`] decides; a caller polishes the roots on its own equations (the
-/// deflation adds a rounding error of the order of `w`'s).
+/// deflation adds a rounding error of the order of `w`'s). At most two, in a list of
+/// [`CubicRoots`]' size, so that a caller that falls back on [`cubic_roots_in`] keeps one list
+/// type for both and takes this one as it is (no copy).
 #[inline]
-pub fn deflated_roots_in(c: &[f64; 4], w: f64, lo: f64, hi: f64) -> Option<ArrayVec<f64, 2>> {
+pub fn deflated_roots_in(c: &[f64; 4], w: f64, lo: f64, hi: f64) -> Option<ArrayVec<f64, 8>> {
     // Synthetic division: c = (x - w) (a x^2 + b x + k) + remainder.
     let a = c[3];
     let b = c[2] + w * a;

@@ -107,7 +107,7 @@ fn other_roots(g: &ModuleGeometry, p: &Vector3<f64>, certified: Option<Leg1>) ->
         Some(leg1) => {
             let hi = g.r_small1 / g.r_big1 - FAST_MARGIN_RAD;
             match deflated_roots_in(&eq9_coefficients(g, p), leg1.cos, -1.0, hi) {
-                Some(roots) => roots.into_iter().collect(),
+                Some(roots) => roots,
                 None => all_roots(-1.0, hi),
             }
         }
