@@ -7,7 +7,7 @@ use std::io::Cursor;
 use crate::machine::Machine;
 use crate::machine_kin::FirstRowChoice;
 use crate::machine_rows::{MachineIk, OrientationColumns};
-use crate::module_rows::{ModuleFk, ModuleIk};
+use crate::module_rows::{ModuleFkAll, ModuleFkWorking, ModuleIkAll, ModuleIkWorking};
 use crate::pipeline::{self, Units};
 use crate::table::{CsvSource, Sink};
 
@@ -22,22 +22,16 @@ pub fn csv_rows(data: &[u8], fk: bool) {
         let mut sink = Sink::from_writer(Box::new(std::io::sink()), "sink");
         let machine = Machine::default_verne();
         let units = Units::default();
-        let _ = if fk {
-            pipeline::run(
-                &mut ModuleFk { machine, all },
-                &mut source,
-                &mut sink,
-                units,
-                &|_| {},
-            )
-        } else {
-            pipeline::run(
-                &mut ModuleIk { machine, all },
-                &mut source,
-                &mut sink,
-                units,
-                &|_| {},
-            )
+        let (src, snk) = (&mut source, &mut sink);
+        let _ = match (fk, all) {
+            (true, true) => pipeline::run(&mut ModuleFkAll { machine }, src, snk, units, &|_| {}),
+            (true, false) => {
+                pipeline::run(&mut ModuleFkWorking { machine }, src, snk, units, &|_| {})
+            }
+            (false, true) => pipeline::run(&mut ModuleIkAll { machine }, src, snk, units, &|_| {}),
+            (false, false) => {
+                pipeline::run(&mut ModuleIkWorking { machine }, src, snk, units, &|_| {})
+            }
         };
     }
 }

@@ -17,9 +17,10 @@ pub const BATCH_ROWS: usize = 4096;
 /// Output rows a batch aims at: a job that writes several rows per input row (`--all`) reads
 /// fewer input rows per batch, so memory stays bounded whatever the input.
 const BATCH_OUTPUT_ROWS: usize = 2 * BATCH_ROWS;
-/// Bytes of pending rows a batch may hold (three batches are in flight): a row keeps its
-/// solver's fixed-capacity result, about 1 KB for the module (every IK branch) and 6 KB for the
-/// machine (every branch of both orientation solutions), so the machine's batches are shorter.
+/// Bytes of pending rows a batch may hold (three batches are in flight): a row keeps what its
+/// job's `emit` needs, a few dozen bytes for the module's working branch or mode
+/// (`module_rows::Working`), about 1 KB for every branch of the module (`--all`) and 6 KB for
+/// the machine (every branch of both orientation solutions), so those batches are shorter.
 const BATCH_BYTES: usize = 4 << 20;
 
 /// Most numeric input columns a job reads.
@@ -224,7 +225,7 @@ impl<S: Default> Batch<S> {
         }
     }
 
-    /// Reads up to `rows` records, reusing the rows in place (a row holds a solver's
+    /// Reads up to `rows` records, reusing the rows in place (a row can hold a solver's
     /// fixed-capacity result, a kilobyte or more: moving rows would cost more than solving).
     fn fill(&mut self, source: &mut CsvSource, rows: usize) -> Result<(), VerneError> {
         self.filled = 0;

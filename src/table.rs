@@ -492,7 +492,7 @@ pub fn format_number(out: &mut Vec<u8>, v: f64, decimals: Option<usize>) {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// The sink's encoding is byte for byte the csv crate's writer's, on random records of
@@ -538,7 +538,7 @@ mod tests {
 
     /// A writer into a Vec the test keeps (the sink takes a boxed 'static writer).
     #[derive(Clone, Default)]
-    struct SharedBuf(std::sync::Arc<std::sync::Mutex<Vec<u8>>>);
+    pub(crate) struct SharedBuf(pub(crate) std::sync::Arc<std::sync::Mutex<Vec<u8>>>);
     impl Write for SharedBuf {
         fn write(&mut self, b: &[u8]) -> io::Result<usize> {
             self.0.lock().unwrap().extend_from_slice(b);

@@ -3,7 +3,7 @@
 
 use verne::error::VerneError;
 use verne::machine_rows::MachineFk;
-use verne::module_rows::ModuleFk;
+use verne::module_rows::{ModuleFkAll, ModuleFkWorking};
 use verne::table::CsvSource;
 
 use super::{inline_source, load_machine, run_rows, units};
@@ -41,10 +41,11 @@ pub fn run(args: &FkArgs) -> Result<u8, VerneError> {
         };
         run_rows("fk", &mut job, source, args.output.as_ref(), u)
     } else {
-        let mut job = ModuleFk {
-            machine,
-            all: args.all,
-        };
-        run_rows("fk", &mut job, source, args.output.as_ref(), u)
+        let output = args.output.as_ref();
+        if args.all {
+            run_rows("fk", &mut ModuleFkAll { machine }, source, output, u)
+        } else {
+            run_rows("fk", &mut ModuleFkWorking { machine }, source, output, u)
+        }
     }
 }

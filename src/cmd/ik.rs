@@ -6,7 +6,7 @@ use std::path::Path;
 use verne::error::VerneError;
 use verne::machine_kin::FirstRowChoice;
 use verne::machine_rows::{MachineIk, OrientationColumns};
-use verne::module_rows::ModuleIk;
+use verne::module_rows::{ModuleIkAll, ModuleIkWorking};
 use verne::table::CsvSource;
 
 use super::{inline_source, load_machine, run_rows, units};
@@ -71,11 +71,12 @@ pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
             if u.halstreamer {
                 return Err(VerneError::Usage("--format halstreamer writes machine joints: give tool poses (x,y,z with i,j,k or phi1,phi2), not platform points".into()));
             }
-            let mut job = ModuleIk {
-                machine,
-                all: args.all,
-            };
-            run_rows("ik", &mut job, source, args.output.as_ref(), u)?
+            let output = args.output.as_ref();
+            if args.all {
+                run_rows("ik", &mut ModuleIkAll { machine }, source, output, u)?
+            } else {
+                run_rows("ik", &mut ModuleIkWorking { machine }, source, output, u)?
+            }
         }
     };
     if let Some(summary) = apt_summary
