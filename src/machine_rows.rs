@@ -4,14 +4,15 @@
 use arrayvec::ArrayVec;
 use nalgebra::Vector3;
 
+use crate::branches::{Config, Verdict};
 use crate::error::VerneError;
 use crate::machine::Machine;
 use crate::machine_kin::{
-    FirstRowChoice, MAX_MACHINE_IK_BRANCHES, MachineFkModes, PathCandidates, PathError, PathState,
-    machine_fk, path_candidates, path_candidates_into,
+    FirstRowChoice, MAX_MACHINE_IK_BRANCHES, MachineFkMode, MachineFkModes, PathCandidates,
+    PathError, PathState, machine_fk, path_candidates, path_candidates_into,
 };
 use crate::module_geometry::Sliders;
-use crate::module_rows::emit_branches;
+use crate::module_rows::{Working, emit_branches, emit_every, emit_working};
 use crate::orientation::{ToolAngles, ToolOrientation};
 use crate::pipeline::{Cell, RowJob, RowOutcome, RowWriter};
 
@@ -264,11 +265,17 @@ fn bad_row(out: &mut RowWriter<'_>, e: &PathError, all: bool) -> Result<RowOutco
     Ok(RowOutcome { ok: false, status })
 }
 
-/// Machine FK: joints -> tool tip, axis and (phi1, phi2) in the workpiece frame.
-pub struct MachineFk {
+/// Machine FK: joints -> tool tip, axis and (phi1, phi2) in the workpiece frame, every assembly
+/// mode (`verne fk --all` on machine joints).
+pub struct MachineFkAll {
     pub machine: Machine,
     pub tool_length: f64,
-    pub all: bool,
+}
+
+/// Machine FK, the working assembly mode of each row (`verne fk` on machine joints).
+pub struct MachineFkWorking {
+    pub machine: Machine,
+    pub tool_length: f64,
 }
 
 const FK_INPUTS: &[(&str, bool)] = &[
@@ -283,7 +290,36 @@ const FK_OUT_ALL: &[&str] = &[
     "branch", "x", "y", "z", "i", "j", "k", "phi1", "phi2", "s1", "s2", "s3", "working", "status",
 ];
 
-impl RowJob for MachineFk {
+/// Every assembly mode of a row of machine joints.
+fn machine_fk_row(m: &Machine, tool_length: f64, inputs: &[f64]) -> MachineFkModes {
+    let rho = Sliders::new(inputs[0], inputs[1], inputs[2]);
+    machine_fk(m, &rho, inputs[3], inputs[4], tool_length)
+}
+
+/// The machine's mode: the feasible one (the smallest |alpha| if several are).
+fn working_machine_mode(modes: &MachineFkModes) -> Option<&MachineFkMode> {
+    modes
+        .iter()
+        .filter(|m| m.working())
+        .min_by(|a, b| a.module.alpha.abs().total_cmp(&b.module.alpha.abs()))
+}
+
+/// The written values of a machine assembly mode.
+fn machine_fk_parts(m: &MachineFkMode) -> ([Cell; 8], Config, Verdict) {
+    let values = [
+        Cell::Num(m.tool.tip.x),
+        Cell::Num(m.tool.tip.y),
+        Cell::Num(m.tool.tip.z),
+        Cell::Num(m.axis.x),
+        Cell::Num(m.axis.y),
+        Cell::Num(m.axis.z),
+        Cell::Angle(m.tool.phi1),
+        Cell::Angle(m.tool.phi2),
+    ];
+    (values, m.config, m.verdict)
+}
+
+impl RowJob for MachineFkAll {
     type Solved = MachineFkModes;
 
     fn inputs(&self) -> &[(&'static str, bool)] {
@@ -291,12 +327,11 @@ impl RowJob for MachineFk {
     }
 
     fn outputs(&self) -> &[&'static str] {
-        if self.all { FK_OUT_ALL } else { FK_OUT_WORKING }
+        FK_OUT_ALL
     }
 
     fn solve(&self, inputs: &[f64], solved: &mut MachineFkModes) {
-        let rho = Sliders::new(inputs[0], inputs[1], inputs[2]);
-        *solved = machine_fk(&self.machine, &rho, inputs[3], inputs[4], self.tool_length);
+        *solved = machine_fk_row(&self.machine, self.tool_length, inputs);
     }
 
     fn emit(
@@ -304,22 +339,31 @@ impl RowJob for MachineFk {
         modes: &MachineFkModes,
         out: &mut RowWriter<'_>,
     ) -> Result<RowOutcome, VerneError> {
-        let working = modes
-            .iter()
-            .filter(|m| m.working())
-            .min_by(|a, b| a.module.alpha.abs().total_cmp(&b.module.alpha.abs()));
-        emit_branches(out, self.all, modes, working, |m| {
-            let values = [
-                Cell::Num(m.tool.tip.x),
-                Cell::Num(m.tool.tip.y),
-                Cell::Num(m.tool.tip.z),
-                Cell::Num(m.axis.x),
-                Cell::Num(m.axis.y),
-                Cell::Num(m.axis.z),
-                Cell::Angle(m.tool.phi1),
-                Cell::Angle(m.tool.phi2),
-            ];
-            (values, m.config, m.verdict)
-        })
+        emit_every(out, modes, machine_fk_parts)
+    }
+}
+
+impl RowJob for MachineFkWorking {
+    type Solved = Working<MachineFkMode>;
+
+    fn inputs(&self) -> &[(&'static str, bool)] {
+        FK_INPUTS
+    }
+
+    fn outputs(&self) -> &[&'static str] {
+        FK_OUT_WORKING
+    }
+
+    fn solve(&self, inputs: &[f64], solved: &mut Working<MachineFkMode>) {
+        let modes = machine_fk_row(&self.machine, self.tool_length, inputs);
+        *solved = Working::of(&modes, working_machine_mode(&modes), |m| m.verdict);
+    }
+
+    fn emit(
+        &mut self,
+        w: &Working<MachineFkMode>,
+        out: &mut RowWriter<'_>,
+    ) -> Result<RowOutcome, VerneError> {
+        emit_working(out, w.found(), machine_fk_parts)
     }
 }

@@ -2,7 +2,7 @@
 //! pose of the parallel module (IFToMM 2007, section VI).
 
 use verne::error::VerneError;
-use verne::machine_rows::MachineFk;
+use verne::machine_rows::{MachineFkAll, MachineFkWorking};
 use verne::module_rows::{ModuleFkAll, ModuleFkWorking};
 use verne::table::CsvSource;
 
@@ -34,12 +34,21 @@ pub fn run(args: &FkArgs) -> Result<u8, VerneError> {
     };
     let table = source.column("theta1").is_some() || source.column("theta2").is_some();
     if table {
-        let mut job = MachineFk {
-            tool_length: args.tool_length.unwrap_or(machine.tool_length),
-            machine,
-            all: args.all,
-        };
-        run_rows("fk", &mut job, source, args.output.as_ref(), u)
+        let tool_length = args.tool_length.unwrap_or(machine.tool_length);
+        let output = args.output.as_ref();
+        if args.all {
+            let mut job = MachineFkAll {
+                machine,
+                tool_length,
+            };
+            run_rows("fk", &mut job, source, output, u)
+        } else {
+            let mut job = MachineFkWorking {
+                machine,
+                tool_length,
+            };
+            run_rows("fk", &mut job, source, output, u)
+        }
     } else {
         let output = args.output.as_ref();
         if args.all {
