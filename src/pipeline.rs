@@ -331,6 +331,20 @@ pub fn run<J: RowJob>(
         delimiter: sink.delimiter(),
         file: &file,
     };
+    // The loop runs on one of rayon's workers (`rayon::scope` moves it there from the calling
+    // thread, which then waits once for the whole run): its joins hand work to the other worker
+    // directly, instead of waking the calling thread and a worker at every batch.
+    rayon::scope(|_| stream_batches(job, source, sink, &plan, progress))
+}
+
+/// The loop of [`run`]: three batches in flight, read, solved and written side by side.
+fn stream_batches<J: RowJob>(
+    job: &mut J,
+    source: &mut CsvSource,
+    sink: &mut Sink,
+    plan: &Plan<'_>,
+    progress: Progress<'_>,
+) -> Result<RunSummary, VerneError> {
     let mut summary = RunSummary::default();
     let (mut reading, mut solving, mut writing) =
         (Batch::<J::Solved>::new(), Batch::new(), Batch::new());
@@ -344,7 +358,7 @@ pub fn run<J: RowJob>(
             || {
                 rayon::join(
                     || writing.write(sink),
-                    || process(job, &mut solving, &plan, &mut summary),
+                    || process(job, &mut solving, plan, &mut summary),
                 )
             },
         );
