@@ -12,7 +12,7 @@ use crate::machine_kin::{
     PathError, PathState, machine_fk, path_candidates, path_candidates_into,
 };
 use crate::module_geometry::Sliders;
-use crate::module_rows::{Working, emit_branches, emit_every, emit_working};
+use crate::module_rows::{Working, emit_every, emit_working};
 use crate::orientation::{ToolAngles, ToolOrientation};
 use crate::pipeline::{Cell, RowJob, RowOutcome, RowWriter};
 
@@ -200,7 +200,7 @@ impl RowJob for MachineIk {
         if self.all {
             let branches: ArrayVec<_, { 2 * MAX_MACHINE_IK_BRANCHES }> =
                 candidates.iter().collect();
-            return emit_branches(out, true, &branches, None, |(b, orientation, theta2)| {
+            return emit_every(out, &branches, |(b, orientation, theta2)| {
                 let values = [
                     Cell::Int((*orientation).into()),
                     Cell::Num(b.rho.x),

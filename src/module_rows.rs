@@ -176,22 +176,6 @@ impl Working<FkMode> {
     }
 }
 
-/// Writes one input row's branches: with `all`, [`emit_every`]; otherwise [`emit_working`].
-pub fn emit_branches<T, const N: usize>(
-    out: &mut RowWriter<'_>,
-    all: bool,
-    branches: &[T],
-    working: Option<&T>,
-    parts: impl Fn(&T) -> ([Cell; N], Config, Verdict),
-) -> Result<RowOutcome, VerneError> {
-    if all {
-        return emit_every(out, branches, parts);
-    }
-    let found = working
-        .ok_or_else(|| missing_status(branches.iter().map(|b| parts(b).2), branches.is_empty()));
-    emit_working(out, found, parts)
-}
-
 /// One row per branch (`branch`, values, `s1,s2,s3`, `working`, `status`), or one
 /// `unreachable` row when there is none.
 pub fn emit_every<T, const N: usize>(
@@ -410,12 +394,20 @@ mod tests {
         }
 
         fn emit(&mut self, kept: &Kept, out: &mut RowWriter<'_>) -> Result<RowOutcome, VerneError> {
+            // The working branch picked here, from every branch kept, as the old emit did.
+            fn picked<'a, T>(
+                all: &'a [T],
+                working: Option<&'a T>,
+                verdict: impl Fn(&T) -> Verdict,
+            ) -> Result<&'a T, Cell> {
+                working.ok_or_else(|| missing_status(all.iter().map(verdict), all.is_empty()))
+            }
             if self.fk {
-                let working = module_fk::working(&kept.fk);
-                emit_branches(out, false, &kept.fk, working, fk_parts)
+                let found = picked(&kept.fk, module_fk::working(&kept.fk), |m| m.verdict);
+                emit_working(out, found, fk_parts)
             } else {
-                let working = module_ik::working(&kept.ik);
-                emit_branches(out, false, &kept.ik, working, ik_parts)
+                let found = picked(&kept.ik, module_ik::working(&kept.ik), |b| b.verdict);
+                emit_working(out, found, ik_parts)
             }
         }
     }
