@@ -549,6 +549,17 @@ impl Fixture {
         n
     }
 
+    /// [`Self::run_ik_all_lanes`] with `solve_each` built for the x86-64 baseline (no AVX2).
+    fn run_ik_all_lanes_baseline(&self, pts: &[Vector3<f64>]) -> usize {
+        let mut n = 0;
+        self.run_ik_runs(
+            pts,
+            |m, rows| module_ik::solve_each_baseline(m, rows),
+            |_, b| n += b.len(),
+        );
+        n
+    }
+
     fn run_newton_ik(&self) -> (f64, u64) {
         let g = &self.machine.module;
         let mut q = self.path_joints[0];
@@ -954,6 +965,12 @@ const KERNELS: &[(&str, &str, &str, &str)] = &[
         "< 100 ns/pose and <= 0.5x Newton IK (each point alone, four side by side, as `verne ik`)",
     ),
     (
+        "ik/working_lanes_baseline",
+        "module pose",
+        "ik/newton_warm",
+        "(the same built for the x86-64 baseline, without AVX2)",
+    ),
+    (
         "ik/all_branches",
         "module pose",
         "ik/newton_warm",
@@ -964,6 +981,12 @@ const KERNELS: &[(&str, &str, &str, &str)] = &[
         "module pose",
         "ik/newton_warm",
         "< 250 ns/pose (all sixteen branches, four side by side, as `verne ik --all`)",
+    ),
+    (
+        "ik/all_branches_lanes_baseline",
+        "module pose",
+        "ik/newton_warm",
+        "(the same built for the x86-64 baseline, without AVX2)",
     ),
     (
         "ik/working_branch_scattered",
@@ -1112,6 +1135,9 @@ fn main() {
     bench(&mut c, &rec, "ik", "all_branches_lanes", n, || {
         fx.run_ik_all_lanes(&fx.path)
     });
+    bench(&mut c, &rec, "ik", "all_branches_lanes_baseline", n, || {
+        fx.run_ik_all_lanes_baseline(&fx.path)
+    });
     bench(&mut c, &rec, "ik", "working_branch_scattered", n, || {
         fx.run_ik_working(&fx.scatter)
     });
@@ -1122,6 +1148,19 @@ fn main() {
                 acc += w.rho.x;
             }
         });
+        acc
+    });
+    bench(&mut c, &rec, "ik", "working_lanes_baseline", n, || {
+        let mut acc = 0.0;
+        fx.run_ik_runs(
+            &fx.path,
+            |m, rows| module_ik::solve_working_each_baseline(m, rows),
+            |_, b| {
+                if let Some(w) = module_ik::working(b) {
+                    acc += w.rho.x;
+                }
+            },
+        );
         acc
     });
     bench(&mut c, &rec, "ik", "newton_warm", n, || fx.run_newton_ik());

@@ -5,6 +5,7 @@
 pub mod apt;
 pub mod arg_values;
 pub mod branches;
+pub mod cpu;
 pub mod cubic;
 pub mod error;
 #[doc(hidden)]

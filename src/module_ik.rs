@@ -17,6 +17,7 @@ use crate::branches::{
     Config, Verdict, WORKING_CONFIG, cos_tilt_max, leg_state, listed_in_order, outer_leg_labels,
     outer_leg_states, rods_cross, stroke_verdict,
 };
+use crate::cpu;
 use crate::cubic::{cubic_roots_in, deflated_roots_in};
 use crate::machine::{Machine, ModuleGeometry};
 use crate::module_geometry::Sliders;
@@ -481,8 +482,42 @@ pub fn solve_into(m: &Machine, p: &Vector3<f64>, out: &mut IkBranches) {
 /// [`solve_into`] for each point of `rows` into its list, [`LANES`] points at a time: the
 /// certified root of (9) side by side (`certified_lanes`), then each point's other roots, its
 /// postures, its branches, phase by phase (each point alone all the same: the lists are what
-/// [`solve_into`] gives).
+/// [`solve_into`] gives). Built with AVX2 where the processor has it ([`crate::cpu`]).
 pub fn solve_each<'a>(
+    m: &Machine,
+    rows: impl IntoIterator<Item = (Vector3<f64>, &'a mut IkBranches)>,
+) {
+    #[cfg(target_arch = "x86_64")]
+    if cpu::has_avx2() {
+        // SAFETY: the processor has AVX2 (checked just above).
+        return unsafe { solve_each_avx2(m, rows) };
+    }
+    solve_each_baseline(m, rows)
+}
+
+/// [`solve_each`] built for the x86-64 baseline whatever the processor has: the same lists, bit
+/// for bit.
+pub fn solve_each_baseline<'a>(
+    m: &Machine,
+    rows: impl IntoIterator<Item = (Vector3<f64>, &'a mut IkBranches)>,
+) {
+    solve_each_built::<false>(m, rows)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn solve_each_avx2<'a>(
+    m: &Machine,
+    rows: impl IntoIterator<Item = (Vector3<f64>, &'a mut IkBranches)>,
+) {
+    solve_each_built::<true>(m, rows)
+}
+
+/// The body of [`solve_each`], inlined into each build. `AVX2` only tells the builds apart: each
+/// then has its own copy of the closures below (one shared copy would be built for the
+/// baseline and called from both).
+#[inline(always)]
+fn solve_each_built<'a, const AVX2: bool>(
     m: &Machine,
     rows: impl IntoIterator<Item = (Vector3<f64>, &'a mut IkBranches)>,
 ) {
@@ -532,6 +567,7 @@ fn in_lanes<'a>(
 
 /// Every branch on the leg-I postures `legs1` of `p` into `out` (cleared first), ordered and
 /// labelled as [`solve`] gives them.
+#[inline(always)]
 fn branches_into(m: &Machine, p: &Vector3<f64>, legs1: &ArrayVec<Leg1, 6>, out: &mut IkBranches) {
     out.clear();
     if !p.iter().all(|v| v.is_finite()) {
@@ -844,7 +880,7 @@ pub const LANES: usize = 4;
 /// lockstep and without a branch, so the processor overlaps their dependency chains (a square
 /// root and a division for the start, a division and the sin/cos series for the step, two
 /// square roots for (12)-(13)).
-#[inline]
+#[inline(always)]
 pub fn working_lanes<const N: usize>(
     m: &Machine,
     pts: &[Vector3<f64>; N],
@@ -962,8 +998,42 @@ fn working_or_all_into(
 
 /// [`solve_working_into`] for each point of `rows` into its list, [`LANES`] points at a time
 /// through [`working_lanes`] (each point alone all the same: the lists are what
-/// [`solve_working_into`] gives, in the same order).
+/// [`solve_working_into`] gives, in the same order). Built with AVX2 where the processor has it
+/// ([`crate::cpu`]).
 pub fn solve_working_each<'a>(
+    m: &Machine,
+    rows: impl IntoIterator<Item = (Vector3<f64>, &'a mut IkBranches)>,
+) {
+    #[cfg(target_arch = "x86_64")]
+    if cpu::has_avx2() {
+        // SAFETY: the processor has AVX2 (checked just above).
+        return unsafe { solve_working_each_avx2(m, rows) };
+    }
+    solve_working_each_baseline(m, rows)
+}
+
+/// [`solve_working_each`] built for the x86-64 baseline whatever the processor has: the same
+/// lists, bit for bit.
+pub fn solve_working_each_baseline<'a>(
+    m: &Machine,
+    rows: impl IntoIterator<Item = (Vector3<f64>, &'a mut IkBranches)>,
+) {
+    solve_working_each_built::<false>(m, rows)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn solve_working_each_avx2<'a>(
+    m: &Machine,
+    rows: impl IntoIterator<Item = (Vector3<f64>, &'a mut IkBranches)>,
+) {
+    solve_working_each_built::<true>(m, rows)
+}
+
+/// The body of [`solve_working_each`], inlined into each build (`AVX2` as for
+/// [`solve_each_built`]).
+#[inline(always)]
+fn solve_working_each_built<'a, const AVX2: bool>(
     m: &Machine,
     rows: impl IntoIterator<Item = (Vector3<f64>, &'a mut IkBranches)>,
 ) {

@@ -325,8 +325,16 @@ fn helix_points(rows: usize) -> Vec<Vector3<f64>> {
         .collect()
 }
 
+/// The bits of a branch, so that -0.0 and 0.0 (or two NaNs) are told apart.
+fn branch_bits(b: &module_ik::IkBranch) -> ([u64; 4], [i8; 3], String) {
+    let bits = [b.alpha, b.rho.x, b.rho.y, b.rho.z].map(f64::to_bits);
+    (bits, b.config, format!("{:?}", b.verdict))
+}
+
 /// `module_ik::solve_each` (four points side by side, as `verne ik --all`) gives exactly the
-/// lists `module_ik::solve` gives, branch for branch and bit for bit, whatever the grouping.
+/// lists `module_ik::solve` gives, branch for branch and bit for bit, whatever the grouping;
+/// and so does its baseline x86-64 build (`solve_each` runs the AVX2 build where the processor
+/// has AVX2).
 #[test]
 fn solve_each_gives_solves_lists() {
     let m = Machine::default_verne();
@@ -336,14 +344,49 @@ fn solve_each_gives_solves_lists() {
     pts.extend(
         (0..400).map(|k| Vector3::new(-250.0, [0.0, 1e-9, -1e-7, 1e-4][k % 4], 1000.0 + k as f64)),
     );
+    // Cells a CSV may hold: not finite, or far out.
+    for v in [f64::NAN, f64::INFINITY, -f64::INFINITY, 1e300, -0.0] {
+        pts.extend([
+            Vector3::new(v, 0.0, 1000.0),
+            Vector3::new(-250.0, v, 1000.0),
+            Vector3::new(-250.0, 10.0, v),
+        ]);
+    }
     for skip in [0, 1, 3] {
         let mut got = vec![IkBranches::new(); pts.len() - skip];
         module_ik::solve_each(&m, pts[skip..].iter().copied().zip(got.iter_mut()));
-        for (p, got) in pts[skip..].iter().zip(&got) {
+        let mut baseline = vec![IkBranches::new(); pts.len() - skip];
+        module_ik::solve_each_baseline(&m, pts[skip..].iter().copied().zip(baseline.iter_mut()));
+        for ((p, got), baseline) in pts[skip..].iter().zip(&got).zip(&baseline) {
             let expected = module_ik::solve(&m, p);
-            assert_eq!(got.as_slice(), expected.as_slice(), "p={p:?}");
+            for list in [got, baseline] {
+                let bits: Vec<_> = list.iter().map(branch_bits).collect();
+                let expected: Vec<_> = expected.iter().map(branch_bits).collect();
+                assert_eq!(bits, expected, "p={p:?}");
+            }
         }
     }
+}
+
+/// `module_ik::solve_working_each` (as `verne ik`) gives the lists of its baseline x86-64 build
+/// bit for bit (it runs the AVX2 build where the processor has AVX2).
+#[test]
+fn solve_working_each_builds_agree() {
+    let m = Machine::default_verne();
+    let mut pts = helix_points(1024);
+    pts.extend(random_points(23, 20_000));
+    pts.extend([f64::NAN, f64::INFINITY, 1e300].map(|v| Vector3::new(-250.0, v, 1000.0)));
+    let mut got = vec![IkBranches::new(); pts.len()];
+    module_ik::solve_working_each(&m, pts.iter().copied().zip(got.iter_mut()));
+    let mut baseline = vec![IkBranches::new(); pts.len()];
+    module_ik::solve_working_each_baseline(&m, pts.iter().copied().zip(baseline.iter_mut()));
+    let mut working = 0;
+    for ((p, got), baseline) in pts.iter().zip(&got).zip(&baseline) {
+        let bits = |list: &IkBranches| list.iter().map(branch_bits).collect::<Vec<_>>();
+        assert_eq!(bits(got), bits(baseline), "p={p:?}");
+        working += usize::from(module_ik::working(got).is_some());
+    }
+    assert!(working > 2000, "{working} points with a working branch");
 }
 
 #[test]

@@ -1,0 +1,28 @@
+//! What the processor offers beyond the x86-64 baseline the crate is built for (SSE2).
+//!
+//! The module IK's kernels that `verne ik` runs ([`crate::module_ik::solve_working_each`],
+//! [`crate::module_ik::solve_each`]) are built twice, for the baseline and with AVX2, and
+//! choose at run time. With AVX2 the four points they solve side by side fit one register, and
+//! three-operand instructions leave out most of the register copies that two-operand SSE2
+//! needs: a third fewer instructions for the working branch, 15 % fewer for every branch
+//! (docs/benchmarks.md). Both builds give the same results bit for bit (Rust neither fuses nor
+//! reorders floating-point operations, whatever the instruction set); the tests compare them.
+//!
+//! The pattern: the public function checks [`has_avx2`] and calls a private one marked
+//! `#[target_feature(enable = "avx2")]`; both inline one body (`#[inline(always)]`, with what it
+//! calls in the hot loop), which takes a `const AVX2: bool` only to tell the builds apart, so
+//! that each has its own copy of the closures inside (one copy, called from both, would be
+//! built for the baseline).
+
+/// True when the processor runs AVX2 code (the standard library asks it once and remembers).
+#[inline]
+pub fn has_avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::is_x86_feature_detected!("avx2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
