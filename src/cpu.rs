@@ -8,11 +8,11 @@
 //! (docs/benchmarks.md). Both builds give the same results bit for bit (Rust neither fuses nor
 //! reorders floating-point operations, whatever the instruction set); the tests compare them.
 //!
-//! The pattern: the public function checks [`has_avx2`] and calls a private one marked
-//! `#[target_feature(enable = "avx2")]`; both inline one body (`#[inline(always)]`, with what it
-//! calls in the hot loop), which takes a `const AVX2: bool` only to tell the builds apart, so
-//! that each has its own copy of the closures inside (one copy, called from both, would be
-//! built for the baseline).
+//! The pattern (`module_ik::each_in_lanes`): one dispatcher checks [`has_avx2`] and calls a
+//! function marked `#[target_feature(enable = "avx2")]` or the baseline one; both inline one
+//! body (`#[inline(always)]`, with what it calls in the hot loop), which takes a
+//! `const AVX2: bool` only to tell the builds apart, so that each has its own copy of the
+//! closures inside (one copy, called from both, would be built for the baseline).
 
 /// True when the processor runs AVX2 code (the standard library asks it once and remembers).
 #[inline]

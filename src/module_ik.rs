@@ -487,12 +487,7 @@ pub fn solve_each<'a>(
     m: &Machine,
     rows: impl IntoIterator<Item = (Vector3<f64>, &'a mut IkBranches)>,
 ) {
-    #[cfg(target_arch = "x86_64")]
-    if cpu::has_avx2() {
-        // SAFETY: the processor has AVX2 (checked just above).
-        return unsafe { solve_each_avx2(m, rows) };
-    }
-    solve_each_baseline(m, rows)
+    each_in_lanes::<true>(m, rows)
 }
 
 /// [`solve_each`] built for the x86-64 baseline whatever the processor has: the same lists, bit
@@ -501,26 +496,81 @@ pub fn solve_each_baseline<'a>(
     m: &Machine,
     rows: impl IntoIterator<Item = (Vector3<f64>, &'a mut IkBranches)>,
 ) {
-    solve_each_built::<false>(m, rows)
+    each_in_lanes_baseline::<true>(m, rows)
+}
+
+/// [`solve_working_into`] for each point of `rows` into its list, [`LANES`] points at a time
+/// through [`working_lanes`] (each point alone all the same: the lists are what
+/// [`solve_working_into`] gives, in the same order). Built with AVX2 where the processor has it
+/// ([`crate::cpu`]).
+pub fn solve_working_each<'a>(
+    m: &Machine,
+    rows: impl IntoIterator<Item = (Vector3<f64>, &'a mut IkBranches)>,
+) {
+    each_in_lanes::<false>(m, rows)
+}
+
+/// [`solve_working_each`] built for the x86-64 baseline whatever the processor has: the same
+/// lists, bit for bit.
+pub fn solve_working_each_baseline<'a>(
+    m: &Machine,
+    rows: impl IntoIterator<Item = (Vector3<f64>, &'a mut IkBranches)>,
+) {
+    each_in_lanes_baseline::<false>(m, rows)
+}
+
+/// [`solve_each`] (`EVERY`) or [`solve_working_each`], built with AVX2 when the processor has it.
+fn each_in_lanes<'a, const EVERY: bool>(
+    m: &Machine,
+    rows: impl IntoIterator<Item = (Vector3<f64>, &'a mut IkBranches)>,
+) {
+    #[cfg(target_arch = "x86_64")]
+    if cpu::has_avx2() {
+        // SAFETY: the processor has AVX2 (checked just above).
+        return unsafe { each_in_lanes_avx2::<EVERY>(m, rows) };
+    }
+    each_in_lanes_baseline::<EVERY>(m, rows)
+}
+
+fn each_in_lanes_baseline<'a, const EVERY: bool>(
+    m: &Machine,
+    rows: impl IntoIterator<Item = (Vector3<f64>, &'a mut IkBranches)>,
+) {
+    each_in_lanes_built::<false, EVERY>(m, rows)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn solve_each_avx2<'a>(
+fn each_in_lanes_avx2<'a, const EVERY: bool>(
     m: &Machine,
     rows: impl IntoIterator<Item = (Vector3<f64>, &'a mut IkBranches)>,
 ) {
-    solve_each_built::<true>(m, rows)
+    each_in_lanes_built::<true, EVERY>(m, rows)
 }
 
-/// The body of [`solve_each`], inlined into each build. `AVX2` only tells the builds apart: each
-/// then has its own copy of the closures below (one shared copy would be built for the
-/// baseline and called from both).
+/// The body of [`each_in_lanes`], inlined into each build: every branch ([`solve_into`]) when
+/// `EVERY`, else what `verne ik` needs ([`solve_working_into`]). `AVX2` only tells the builds
+/// apart: each then has its own copy of the closures below (one shared copy would be built for
+/// the baseline and called from both).
 #[inline(always)]
-fn solve_each_built<'a, const AVX2: bool>(
+fn each_in_lanes_built<'a, const AVX2: bool, const EVERY: bool>(
     m: &Machine,
     rows: impl IntoIterator<Item = (Vector3<f64>, &'a mut IkBranches)>,
 ) {
+    if !EVERY {
+        return in_lanes(
+            rows,
+            |pts, outs| {
+                let found = working_lanes(m, pts);
+                for (k, out) in outs.enumerate() {
+                    // Where the lanes were not sure, the cubic (not the lanes again).
+                    let working = found[k].or_else(|| working_by_cubic(m, &pts[k]));
+                    working_or_all_into(m, &pts[k], working, out);
+                }
+            },
+            |p, out| solve_working_into(m, p, out),
+        );
+    }
     in_lanes(
         rows,
         |pts, outs| {
@@ -994,61 +1044,6 @@ fn working_or_all_into(
         }
         None => solve_into(m, p, out),
     }
-}
-
-/// [`solve_working_into`] for each point of `rows` into its list, [`LANES`] points at a time
-/// through [`working_lanes`] (each point alone all the same: the lists are what
-/// [`solve_working_into`] gives, in the same order). Built with AVX2 where the processor has it
-/// ([`crate::cpu`]).
-pub fn solve_working_each<'a>(
-    m: &Machine,
-    rows: impl IntoIterator<Item = (Vector3<f64>, &'a mut IkBranches)>,
-) {
-    #[cfg(target_arch = "x86_64")]
-    if cpu::has_avx2() {
-        // SAFETY: the processor has AVX2 (checked just above).
-        return unsafe { solve_working_each_avx2(m, rows) };
-    }
-    solve_working_each_baseline(m, rows)
-}
-
-/// [`solve_working_each`] built for the x86-64 baseline whatever the processor has: the same
-/// lists, bit for bit.
-pub fn solve_working_each_baseline<'a>(
-    m: &Machine,
-    rows: impl IntoIterator<Item = (Vector3<f64>, &'a mut IkBranches)>,
-) {
-    solve_working_each_built::<false>(m, rows)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn solve_working_each_avx2<'a>(
-    m: &Machine,
-    rows: impl IntoIterator<Item = (Vector3<f64>, &'a mut IkBranches)>,
-) {
-    solve_working_each_built::<true>(m, rows)
-}
-
-/// The body of [`solve_working_each`], inlined into each build (`AVX2` as for
-/// [`solve_each_built`]).
-#[inline(always)]
-fn solve_working_each_built<'a, const AVX2: bool>(
-    m: &Machine,
-    rows: impl IntoIterator<Item = (Vector3<f64>, &'a mut IkBranches)>,
-) {
-    in_lanes(
-        rows,
-        |pts, outs| {
-            let found = working_lanes(m, pts);
-            for (k, out) in outs.enumerate() {
-                // Where the lanes were not sure, the cubic (not the lanes again).
-                let working = found[k].or_else(|| working_by_cubic(m, &pts[k]));
-                working_or_all_into(m, &pts[k], working, out);
-            }
-        },
-        |p, out| solve_working_into(m, p, out),
-    );
 }
 
 /// The machine's branch: the unique feasible one, or (if several are feasible, which the default
