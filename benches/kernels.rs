@@ -1001,6 +1001,12 @@ const KERNELS: &[(&str, &str, &str, &str)] = &[
         "< 2 us/pose",
     ),
     (
+        "fk/all_modes_baseline",
+        "slider row",
+        "fk/newton_warm",
+        "(the same built for the x86-64 baseline, without AVX2)",
+    ),
+    (
         "fk/all_modes_scattered",
         "slider row",
         "fk/newton_warm",
@@ -1167,6 +1173,12 @@ fn main() {
 
     bench(&mut c, &rec, "fk", "all_modes", n, || {
         fx.run_fk_all(path_rho.iter().copied())
+    });
+    bench(&mut c, &rec, "fk", "all_modes_baseline", n, || {
+        path_rho
+            .iter()
+            .map(|r| module_fk::solve_baseline(&fx.machine, black_box(r)).len())
+            .sum::<usize>()
     });
     let ns = fx.scatter_joints.len();
     bench(&mut c, &rec, "fk", "all_modes_scattered", ns, || {

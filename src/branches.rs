@@ -335,7 +335,7 @@ pub fn rods_cross(m: &Machine, c: f64) -> Verdict {
 
 /// Configuration and verdict of a pose of the module with slider positions `rho`, from
 /// (s, c) = sin, cos of its alpha: [`config_of`] and [`module_verdict`] in one pass over the legs.
-#[inline]
+#[inline(always)]
 pub fn label(
     m: &Machine,
     p: &nalgebra::Vector3<f64>,
@@ -344,8 +344,8 @@ pub fn label(
     rho: &Sliders,
 ) -> (Config, Verdict) {
     let ct = cos_tilt_max(m);
-    let legs: [(i8, Verdict); 3] =
-        std::array::from_fn(|i| leg_state(m, i, p, s, c, rho[i], ct).check());
+    let leg = |i: usize| leg_state(m, i, p, s, c, rho[i], ct).check();
+    let legs = [leg(0), leg(1), leg(2)];
     (
         [legs[0].0, legs[1].0, legs[2].0],
         combine(m, c, [legs[0].1, legs[1].1, legs[2].1]),

@@ -1,18 +1,23 @@
 //! What the processor offers beyond the x86-64 baseline the crate is built for (SSE2).
 //!
 //! The module IK's kernels that `verne ik` runs ([`crate::module_ik::solve_working_each`],
-//! [`crate::module_ik::solve_each`]) are built twice, for the baseline and with AVX2, and
-//! choose at run time. With AVX2 the four points they solve side by side fit one register, and
-//! three-operand instructions leave out most of the register copies that two-operand SSE2
-//! needs: a third fewer instructions for the working branch, 15 % fewer for every branch
-//! (docs/benchmarks.md). Both builds give the same results bit for bit (Rust neither fuses nor
-//! reorders floating-point operations, whatever the instruction set); the tests compare them.
+//! [`crate::module_ik::solve_each`]), the module FK ([`crate::module_fk::solve`]) and the root
+//! isolation on the circle that the FK, the machine IK and the workspace share
+//! ([`crate::trig::Trig::roots_sin_cos`]) are built twice, for the baseline and with AVX2, and
+//! choose at run time. With AVX2 the four points the IK solves side by side fit one register,
+//! and three-operand instructions leave out most of the register copies that two-operand SSE2
+//! needs: a third fewer instructions for the working branch, 15 % fewer for every branch, a
+//! fifth fewer for the FK (docs/benchmarks.md). Both builds give the same results bit for bit
+//! (Rust neither fuses nor reorders floating-point operations, whatever the instruction set);
+//! the tests compare them.
 //!
 //! The pattern (`module_ik::each_in_lanes`): one dispatcher checks [`has_avx2`] and calls a
 //! function marked `#[target_feature(enable = "avx2")]` or the baseline one; both inline one
 //! body (`#[inline(always)]`, with what it calls in the hot loop), which takes a
 //! `const AVX2: bool` only to tell the builds apart, so that each has its own copy of the
-//! closures inside (one copy, called from both, would be built for the baseline).
+//! closures inside (one copy, called from both, would be built for the baseline). A recursive
+//! function (the root isolation's bisection, `trig::Isolation::interval`) cannot be inlined into
+//! itself: its dispatch calls the function of its build, so the recursion stays in that build.
 
 /// True when the processor runs AVX2 code (the standard library asks it once and remembers).
 #[inline]

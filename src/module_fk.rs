@@ -29,6 +29,7 @@ use arrayvec::ArrayVec;
 use nalgebra::{Matrix3, Vector3};
 
 use crate::branches::{Config, Verdict, label};
+use crate::cpu;
 use crate::machine::{Machine, ModuleGeometry};
 use crate::module_geometry::{ModulePose, Sliders, polish_pose_from, residual_mm};
 use crate::module_ik::wrap_angle;
@@ -68,6 +69,7 @@ struct Elimination {
 }
 
 impl Elimination {
+    #[inline(always)]
     fn new(g: &ModuleGeometry, rho: &Sliders) -> Elimination {
         let (r, rr, r2, r4) = (g.r_big1, g.r_small1, g.r_big2, g.r4);
         let p2 = rho.y - rho.x;
@@ -104,6 +106,7 @@ impl Elimination {
     }
 
     /// F(alpha) of the module documentation (degree 4).
+    #[inline(always)]
     fn characteristic(&self, g: &ModuleGeometry) -> Trig {
         let (r, rr) = (g.r_big1, g.r_small1);
         let n1 = Trig::linear(r * r + rr * rr, -2.0 * r * rr, 0.0);
@@ -120,6 +123,7 @@ impl Elimination {
 
     /// The pose at `alpha` from the linear solution, or None where Det ~ 0; (s, c) = sin, cos of
     /// alpha.
+    #[inline(always)]
     fn back_substitute(
         &self,
         g: &ModuleGeometry,
@@ -245,8 +249,33 @@ fn det_zeros(det: &Trig) -> ArrayVec<(f64, f64), 2> {
 }
 
 /// Every real assembly mode for the slider positions, ordered by alpha, each with its
-/// configuration and verdict. Empty when the sliders cannot be assembled.
+/// configuration and verdict. Empty when the sliders cannot be assembled. Built with AVX2 where
+/// the processor has it ([`crate::cpu`]).
 pub fn solve(m: &Machine, rho: &Sliders) -> FkModes {
+    #[cfg(target_arch = "x86_64")]
+    if cpu::has_avx2() {
+        // SAFETY: the processor has AVX2 (checked just above).
+        return unsafe { solve_avx2(m, rho) };
+    }
+    solve_built::<false>(m, rho)
+}
+
+/// [`solve`] built for the x86-64 baseline whatever the processor has: the same modes, bit for
+/// bit.
+pub fn solve_baseline(m: &Machine, rho: &Sliders) -> FkModes {
+    solve_built::<false>(m, rho)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn solve_avx2(m: &Machine, rho: &Sliders) -> FkModes {
+    solve_built::<true>(m, rho)
+}
+
+/// The body of [`solve`], inlined into each build with what it calls (`AVX2` tells them apart:
+/// see [`crate::cpu`]).
+#[inline(always)]
+fn solve_built<const AVX2: bool>(m: &Machine, rho: &Sliders) -> FkModes {
     let g = &m.module;
     let mut out = FkModes::new();
     if !rho.iter().all(|v| v.is_finite()) {
@@ -256,7 +285,7 @@ pub fn solve(m: &Machine, rho: &Sliders) -> FkModes {
     let f = elim.characteristic(g);
     // Starting poses, each with (sin alpha, cos alpha).
     let mut starts: ArrayVec<(ModulePose, (f64, f64)), 68> = ArrayVec::new();
-    for root in &f.roots_sin_cos() {
+    for root in &f.roots_sin_cos_built::<AVX2>() {
         let (alpha, sc) = (root.x, (root.sin, root.cos));
         match elim.back_substitute(g, rho, alpha, sc) {
             Some(p) => starts.push((p, sc)),

@@ -157,6 +157,7 @@ pub fn polish_pose_with_residual(
 
 /// [`polish_pose_with_residual`] from a start whose (sin alpha, cos alpha) are known; also
 /// returns those of the result.
+#[inline(always)]
 pub fn polish_pose_from(
     g: &ModuleGeometry,
     start: ModulePose,
@@ -236,7 +237,7 @@ pub(crate) fn residuals_jacobian_sin_cos(
 }
 
 /// a^-1 b by Gaussian elimination with partial pivoting; None when a pivot is zero.
-#[inline]
+#[inline(always)]
 fn solve4(mut a: Matrix4<f64>, mut b: Vector4<f64>) -> Option<Vector4<f64>> {
     for k in 0..4 {
         let p = (k..4)

@@ -9,7 +9,7 @@ use crate::poly::Coeffs;
 /// sin and cos of `alpha` = a - d from those of a (a Newton step d): by the angle-difference
 /// formulas with the series of sin d and cos d (two terms for |d| < 1e-3, six up to 0.25: both
 /// exact in double precision), else by `sin_cos`.
-#[inline]
+#[inline(always)]
 pub fn sin_cos_after_step(sin_a: f64, cos_a: f64, alpha: f64, d: f64) -> (f64, f64) {
     let d2 = d * d;
     let (sd, cd) = if d.abs() < 1e-3 {
@@ -218,6 +218,7 @@ impl Trig {
         v
     }
 
+    #[inline(always)]
     fn on_grid(&self) -> [f64; GRID] {
         let mut v = [self.cos[0]; GRID];
         for k in 0..MAX_HARMONIC {
@@ -244,8 +245,29 @@ impl Trig {
         self.roots_sin_cos().iter().map(|r| r.x).collect()
     }
 
-    /// [`Trig::roots`], each with its sine and cosine (carried along the root finding).
+    /// [`Trig::roots`], each with its sine and cosine (carried along the root finding). Built
+    /// with AVX2 where the processor has it ([`crate::cpu`]).
     pub fn roots_sin_cos(&self) -> ArrayVec<TrigRoot, MAX_TRIG_ROOTS> {
+        #[cfg(target_arch = "x86_64")]
+        if crate::cpu::has_avx2() {
+            // SAFETY: the processor has AVX2 (checked just above).
+            return unsafe { roots_sin_cos_avx2(self) };
+        }
+        self.roots_sin_cos_built::<false>()
+    }
+
+    /// [`Trig::roots_sin_cos`] built for the x86-64 baseline whatever the processor has: the
+    /// same roots, bit for bit.
+    pub fn roots_sin_cos_baseline(&self) -> ArrayVec<TrigRoot, MAX_TRIG_ROOTS> {
+        self.roots_sin_cos_built::<false>()
+    }
+
+    /// The body of [`Trig::roots_sin_cos`], inlined into each build (`AVX2` tells them apart:
+    /// see [`crate::cpu`]).
+    #[inline(always)]
+    pub(crate) fn roots_sin_cos_built<const AVX2: bool>(
+        &self,
+    ) -> ArrayVec<TrigRoot, MAX_TRIG_ROOTS> {
         let scale = self
             .cos
             .iter()
@@ -302,7 +324,7 @@ impl Trig {
             let (a, b) = (pt(j), pt(j + 1));
             let found = iso.out.len();
             let near_zero = a.f.abs() <= iso.ef || b.f.abs() <= iso.ef;
-            if near_zero || iso.interval(a, b, 0).is_none() {
+            if near_zero || iso.interval::<AVX2>(a, b, 0).is_none() {
                 iso.out.truncate(found);
                 iso.chart_roots(a.x, b.x);
             }
@@ -436,7 +458,7 @@ struct Isolation {
 
 impl Isolation {
     /// F, F', F'' at x (one sin_cos; cos k x, sin k x by the angle-sum recurrence).
-    #[inline]
+    #[inline(always)]
     fn at(&self, x: f64) -> Pt {
         let (s1, c1) = x.sin_cos();
         self.at_sc(x, s1, c1)
@@ -455,7 +477,7 @@ impl Isolation {
     }
 
     /// [`Isolation::at`] along a root iteration ([`Isolation::sin_cos_following`]).
-    #[inline]
+    #[inline(always)]
     fn at_following(&self, x: f64, last: &std::cell::Cell<Option<(f64, f64, f64)>>) -> Pt {
         let (s1, c1) = Self::sin_cos_following(x, last);
         self.at_sc(x, s1, c1)
@@ -474,7 +496,7 @@ impl Isolation {
         (dot_harmonics(g, &c, &s), dot_harmonics(h, &c, &s))
     }
 
-    #[inline]
+    #[inline(always)]
     fn at_sc(&self, x: f64, s1: f64, c1: f64) -> Pt {
         let (c, s) = harmonics(s1, c1);
         Pt {
@@ -502,15 +524,30 @@ impl Isolation {
     /// exactly where F changes sign) and F'' (F' strictly monotone: at most one critical point,
     /// which splits the interval into two monotone pieces). Intervals none of these decides are
     /// bisected; the bounds shrink four times per bisection, so only the neighbourhood of a triple
-    /// root can reach [`MAX_DEPTH`].
-    fn interval(&mut self, a: Pt, b: Pt, depth: u32) -> Option<()> {
+    /// root can reach [`MAX_DEPTH`]. Runs in the build `AVX2` names ([`crate::cpu`]), through
+    /// a function of its own, so that its recursion stays in the build it started in.
+    #[inline(always)]
+    fn interval<const AVX2: bool>(&mut self, a: Pt, b: Pt, depth: u32) -> Option<()> {
+        #[cfg(target_arch = "x86_64")]
+        if AVX2 {
+            // SAFETY: AVX2 is true only below `roots_sin_cos_avx2`, which runs where the
+            // processor has AVX2.
+            return unsafe { interval_avx2(self, a, b, depth) };
+        }
+        interval_baseline(self, a, b, depth)
+    }
+
+    /// The body of [`Isolation::interval`], inlined into each build; its recursion goes back
+    /// through the dispatch, into the same build.
+    #[inline(always)]
+    fn interval_built<const AVX2: bool>(&mut self, a: Pt, b: Pt, depth: u32) -> Option<()> {
         let h = b.x - a.x;
         let w = h * h * 0.125;
         if same_sign_beyond(a.f, b.f, w * self.m2 + self.ef) {
             return Some(());
         }
         if same_sign_beyond(a.d, b.d, w * self.m3 + self.ed) {
-            self.monotone(a, b);
+            self.monotone::<AVX2>(a, b);
             return Some(());
         }
         if same_sign_beyond(a.s, b.s, w * self.m4 + self.es) {
@@ -524,15 +561,19 @@ impl Isolation {
                 let g = self.at_sc(guess, sg, cg);
                 let splits =
                     opposite_beyond(g.f, a.f, self.ef) && opposite_beyond(g.f, b.f, self.ef);
-                let c = if splits { g } else { self.critical(a, b) };
+                let c = if splits {
+                    g
+                } else {
+                    self.critical::<AVX2>(a, b)
+                };
                 if c.f.abs() <= self.ef {
                     return None;
                 }
-                self.monotone(a, c);
-                self.monotone(c, b);
+                self.monotone::<AVX2>(a, c);
+                self.monotone::<AVX2>(c, b);
             } else {
                 // F' monotone and not changing sign beyond rounding: F monotone.
-                self.monotone(a, b);
+                self.monotone::<AVX2>(a, b);
             }
             return Some(());
         }
@@ -540,8 +581,8 @@ impl Isolation {
         if depth >= MAX_DEPTH || m.f.abs() <= self.ef {
             return None;
         }
-        self.interval(a, m, depth + 1)?;
-        self.interval(m, b, depth + 1)
+        self.interval::<AVX2>(a, m, depth + 1)?;
+        self.interval::<AVX2>(m, b, depth + 1)
     }
 
     /// The roots in [xa, xb] (inside [-pi/2, pi/2] or outside it) from the half-angle chart that
@@ -577,7 +618,8 @@ impl Isolation {
 
     /// F monotone on [a.x, b.x], or convex or concave there with one simple root: its root there
     /// when F changes sign beyond rounding.
-    fn monotone(&mut self, a: Pt, b: Pt) {
+    #[inline(always)]
+    fn monotone<const AVX2: bool>(&mut self, a: Pt, b: Pt) {
         if opposite_beyond(a.f, b.f, self.ef) {
             let start = root_start(a, b);
             let last = std::cell::Cell::new(Some((a.x, a.sin, a.cos)));
@@ -585,28 +627,61 @@ impl Isolation {
                 m2: self.m2,
                 m3: Some(self.m3),
             };
-            let x = newton_bracketed(a.x, b.x, a.f, start, bounds, |x| {
-                let p = self.at_following(x, &last);
-                (p.f, p.d, p.s)
-            });
+            let x = newton_bracketed(
+                a.x,
+                b.x,
+                a.f,
+                start,
+                bounds,
+                #[inline(always)]
+                |x| {
+                    let p = self.at_following(x, &last);
+                    (p.f, p.d, p.s)
+                },
+            );
             self.push(x, Self::sin_cos_following(x, &last));
         }
     }
 
     /// The single root of F' on [a.x, b.x] (F' strictly monotone, changing sign), with F there.
-    fn critical(&self, a: Pt, b: Pt) -> Pt {
+    #[inline(always)]
+    fn critical<const AVX2: bool>(&self, a: Pt, b: Pt) -> Pt {
         let start = hermite_start(a.x, b.x, a.d, b.d, a.s, b.s);
         let last = std::cell::Cell::new(Some((a.x, a.sin, a.cos)));
         let bounds = StepBounds {
             m2: self.m3,
             m3: None,
         };
-        let x = newton_bracketed(a.x, b.x, a.d, start, bounds, |x| {
-            let (g, dg) = Self::pair_following(x, &last, &self.d, &self.s);
-            (g, dg, 0.0)
-        });
+        let x = newton_bracketed(
+            a.x,
+            b.x,
+            a.d,
+            start,
+            bounds,
+            #[inline(always)]
+            |x| {
+                let (g, dg) = Self::pair_following(x, &last, &self.d, &self.s);
+                (g, dg, 0.0)
+            },
+        );
         self.at_following(x, &last)
     }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn roots_sin_cos_avx2(t: &Trig) -> ArrayVec<TrigRoot, MAX_TRIG_ROOTS> {
+    t.roots_sin_cos_built::<true>()
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn interval_avx2(iso: &mut Isolation, a: Pt, b: Pt, depth: u32) -> Option<()> {
+    iso.interval_built::<true>(a, b, depth)
+}
+
+fn interval_baseline(iso: &mut Isolation, a: Pt, b: Pt, depth: u32) -> Option<()> {
+    iso.interval_built::<false>(a, b, depth)
 }
 
 /// cos k x and sin k x, k = 1..=4, from sin x and cos x (angle-sum recurrences).
@@ -619,7 +694,7 @@ fn harmonics(s1: f64, c1: f64) -> ([f64; MAX_HARMONIC], [f64; MAX_HARMONIC]) {
 }
 
 /// t(x) from the harmonics of x ([`harmonics`]).
-#[inline]
+#[inline(always)]
 fn dot_harmonics(t: &Trig, c: &[f64; MAX_HARMONIC], s: &[f64; MAX_HARMONIC]) -> f64 {
     let mut acc = t.cos[0];
     for k in 0..MAX_HARMONIC {
@@ -632,6 +707,7 @@ fn dot_harmonics(t: &Trig, c: &[f64; MAX_HARMONIC], s: &[f64; MAX_HARMONIC]) -> 
 /// Hermite interpolant when both slopes are usable; next to a critical point (an end where F' is
 /// small, near a double root, where Newton from afar would only halve its distance per step),
 /// the root of the second-order Taylor model of F at that end.
+#[inline(always)]
 fn root_start(a: Pt, b: Pt) -> f64 {
     let h = b.x - a.x;
     let (e, dir) = if a.d.abs() <= b.d.abs() {
@@ -660,6 +736,7 @@ fn root_start(a: Pt, b: Pt) -> f64 {
 /// A start for the root of g, monotone on [a, b] with g(a) = ga, g(b) = gb of opposite signs:
 /// the cubic Hermite interpolant of the inverse function x(g) at g = 0 (slopes 1 / g'), or the
 /// secant's root where a slope is unusable.
+#[inline(always)]
 fn hermite_start(a: f64, b: f64, ga: f64, gb: f64, da: f64, db: f64) -> f64 {
     let dy = gb - ga;
     let t = -ga / dy;
@@ -692,6 +769,7 @@ struct StepBounds {
 /// x - d - g'' d^2 / (2 g'), which leaves at most (m2^2 / (2 g'^2) + m3 / (6 |g'|)) |d|^3 (the
 /// e^3 term of its expansion about the root): the iteration stops once that (or the step itself)
 /// is below the rounding of x, or the bracket cannot shrink.
+#[inline(always)]
 fn newton_bracketed(
     mut a: f64,
     mut b: f64,
@@ -931,6 +1009,45 @@ mod tests {
                 }
             }
             assert_roots(&p, &want, 1e-9);
+        }
+    }
+
+    /// [`Trig::roots_sin_cos`] (the AVX2 build where the processor has it) and its baseline
+    /// build give the same roots bit for bit: random forms, forms with double roots and close
+    /// pairs (the chart fallback), zero and not finite.
+    #[test]
+    fn roots_sin_cos_builds_agree() {
+        let mut uniform = crate::test_rng::lcg(0x0bad_cafe_1234_5678);
+        let mut unit = || uniform() * 2.0 - 1.0;
+        let mut forms = vec![
+            Trig::default(),
+            Trig::linear(f64::NAN, 1.0, 0.0),
+            Trig::linear(0.0, f64::INFINITY, 1.0),
+        ];
+        for _ in 0..3000 {
+            let mut p = Trig::default();
+            for k in 0..=MAX_HARMONIC {
+                p.cos[k] = unit();
+                if k > 0 {
+                    p.sin[k] = unit();
+                }
+            }
+            forms.push(p);
+            let (x, sep) = (3.0 * unit(), 1e-9 * (1.0 + unit()));
+            forms.push(from_pairs(&[(x, x + sep), (x - 2.0, 0.5 * unit())]));
+        }
+        let bits = |roots: &[TrigRoot]| -> Vec<[u64; 3]> {
+            roots
+                .iter()
+                .map(|r| [r.x, r.sin, r.cos].map(f64::to_bits))
+                .collect()
+        };
+        for p in &forms {
+            assert_eq!(
+                bits(&p.roots_sin_cos()),
+                bits(&p.roots_sin_cos_baseline()),
+                "{p:?}"
+            );
         }
     }
 }

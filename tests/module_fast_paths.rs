@@ -166,6 +166,53 @@ use verne::fk_track::FkTracker;
 use verne::module_fk::{self, FkModes};
 use verne::module_geometry::Sliders;
 
+/// `module_fk::solve` (the AVX2 build where the processor has it) gives the modes of its
+/// baseline x86-64 build bit for bit: the joints of every IK branch of random points, random
+/// slider triples (a fifth with rho2 = rho3, where Det = 0 on a plane), cells not finite.
+#[test]
+fn fk_solve_builds_agree() {
+    let m = Machine::default_verne();
+    let mut rows: Vec<Sliders> = Vec::new();
+    for p in random_points(29, 3000) {
+        rows.extend(module_ik::solve(&m, &p).iter().map(|b| b.rho));
+    }
+    let mut r = Lcg(31);
+    for k in 0..5000 {
+        let (r1, r2) = (600.0 + 800.0 * r.unit(), 600.0 + 800.0 * r.unit());
+        let r3 = if k % 5 == 0 {
+            r2
+        } else {
+            600.0 + 800.0 * r.unit()
+        };
+        rows.push(Sliders::new(r1, r2, r3));
+    }
+    rows.extend([f64::NAN, f64::INFINITY, 1e300].map(|v| Sliders::new(1000.0, v, 1000.0)));
+    let bits = |modes: &FkModes| -> Vec<_> {
+        modes
+            .iter()
+            .map(|md| {
+                let pose = [md.pose.alpha, md.pose.p.x, md.pose.p.y, md.pose.p.z];
+                (
+                    pose.map(f64::to_bits),
+                    md.config,
+                    format!("{:?}", md.verdict),
+                )
+            })
+            .collect()
+    };
+    let mut modes = 0;
+    for rho in &rows {
+        let got = module_fk::solve(&m, rho);
+        assert_eq!(
+            bits(&got),
+            bits(&module_fk::solve_baseline(&m, rho)),
+            "rho={rho:?}"
+        );
+        modes += got.len();
+    }
+    assert!(modes > rows.len(), "{modes} modes on {} rows", rows.len());
+}
+
 /// Compares the tracked working mode with the complete solver's on every row of a path;
 /// returns (rows with a working mode, rows answered by tracking).
 fn tracked_agrees(m: &Machine, path: &[Sliders]) -> (usize, u64) {
