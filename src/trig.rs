@@ -989,18 +989,24 @@ mod tests {
         }
     }
 
+    /// A form of the highest degree with coefficients from `unit`.
+    fn random_form(unit: &mut impl FnMut() -> f64) -> Trig {
+        let mut p = Trig::default();
+        for k in 0..=MAX_HARMONIC {
+            p.cos[k] = unit();
+            if k > 0 {
+                p.sin[k] = unit();
+            }
+        }
+        p
+    }
+
     #[test]
     fn agrees_with_the_half_angle_charts() {
         let mut uniform = crate::test_rng::lcg(0x1234_5678_9abc_def0);
         let mut unit = || uniform() * 2.0 - 1.0;
         for _ in 0..3000 {
-            let mut p = Trig::default();
-            for k in 0..=MAX_HARMONIC {
-                p.cos[k] = unit();
-                if k > 0 {
-                    p.sin[k] = unit();
-                }
-            }
+            let p = random_form(&mut unit);
             let mut want = Vec::new();
             for shift in [false, true] {
                 let q = p.to_half_angle_poly(shift);
@@ -1025,14 +1031,7 @@ mod tests {
             Trig::linear(0.0, f64::INFINITY, 1.0),
         ];
         for _ in 0..3000 {
-            let mut p = Trig::default();
-            for k in 0..=MAX_HARMONIC {
-                p.cos[k] = unit();
-                if k > 0 {
-                    p.sin[k] = unit();
-                }
-            }
-            forms.push(p);
+            forms.push(random_form(&mut unit));
             let (x, sep) = (3.0 * unit(), 1e-9 * (1.0 + unit()));
             forms.push(from_pairs(&[(x, x + sep), (x - 2.0, 0.5 * unit())]));
         }
