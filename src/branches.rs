@@ -200,7 +200,7 @@ pub fn leg_state(
             let u = p.x + g.dx1;
             let r3 = nalgebra::Vector3::new(u, p.y + dy, p.z + dz - rho_i);
             let r4 = nalgebra::Vector3::new(u, p.y - dy, p.z - dz - rho_i);
-            (rho_i - p.z, too_tilted(r3) | too_tilted(r4))
+            (rho_i - p.z, too_tilted(r3) || too_tilted(r4))
         }
         1 => {
             let r5 = nalgebra::Vector3::new(
@@ -239,9 +239,9 @@ fn outside_stroke(m: &Machine, leg: usize, rho_i: f64) -> bool {
 fn rod_too_tilted(rz: f64, norm_sq: f64, cos_tilt_max: f64) -> bool {
     let (zz, ct2) = (rz * rz, cos_tilt_max * cos_tilt_max);
     if cos_tilt_max >= 0.0 {
-        (rz < 0.0) | (zz < ct2 * norm_sq)
+        rz < 0.0 || zz < ct2 * norm_sq
     } else {
-        (rz < 0.0) & (zz > ct2 * norm_sq)
+        rz < 0.0 && zz > ct2 * norm_sq
     }
 }
 

@@ -158,10 +158,10 @@ pub fn deflated_roots_in(c: &[f64; 4], w: f64, lo: f64, hi: f64) -> Option<Array
     let q = -0.5 * (b + b.signum() * disc.sqrt());
     let (x1, x2) = (q / a, k / q);
     for x in if x1 <= x2 { [x1, x2] } else { [x2, x1] } {
-        if ((x - lo).abs() <= DEFLATED_END_MARGIN) | ((x - hi).abs() <= DEFLATED_END_MARGIN) {
+        if (x - lo).abs() <= DEFLATED_END_MARGIN || (x - hi).abs() <= DEFLATED_END_MARGIN {
             return None;
         }
-        if (x > lo) & (x < hi) {
+        if x > lo && x < hi {
             out.push(x);
         }
     }

@@ -454,7 +454,7 @@ fn angle_diff(a: f64, b: f64) -> f64 {
 #[inline]
 pub(crate) fn leg_root(l: f64, dx: f64, dy: f64) -> Option<f64> {
     let arg = l * l - dx * dx - dy * dy;
-    if (arg < -SQRT_ARG_REL * l * l) | !arg.is_finite() {
+    if arg < -SQRT_ARG_REL * l * l || !arg.is_finite() {
         return None;
     }
     Some(arg.max(0.0).sqrt())
