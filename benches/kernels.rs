@@ -1081,6 +1081,101 @@ const PARTS: &[(&str, &str)] = &[
     ),
 ];
 
+// ------------------------------------------------------------------ pass by pass
+
+/// Rounds of [`PassKernel`]s for the pass-by-pass timing: each round times one pass of every
+/// kernel over its whole input (about 10 ms a round).
+const PASS_ROUNDS: usize = 600;
+
+/// A kernel timed pass by pass: its name in the main table, its baseline's ("" for none), the
+/// target it answers to (ns per input; infinite for none), and one pass over its input (returns
+/// the inputs handled).
+struct PassKernel<'a> {
+    name: &'static str,
+    baseline: &'static str,
+    target_ns: f64,
+    pass: Box<dyn Fn() -> usize + 'a>,
+}
+
+/// ns per input of every pass of every kernel, in the order of the kernels.
+type PassTimes = Vec<Vec<f64>>;
+
+/// The `q` quantile of sorted `v`, nearest rank.
+fn quantile(v: &[f64], q: f64) -> f64 {
+    v[((v.len() - 1) as f64 * q).round() as usize]
+}
+
+/// Times the kernels pass by pass, `rounds` rounds of one pass each, in a different order every
+/// round. Criterion's samples each average many passes over some 150 ms. This machine is a
+/// virtual one whose vCPUs share physical cores with load from outside it (at times for seconds,
+/// at times for minutes), and a throughput-bound kernel then runs up to 1.8 times slower (a
+/// latency-bound one, such as the Newton baselines, hardly slower): a sample's mean mixes the
+/// two states in whatever share the run met. Single passes of about a millisecond mostly fall in
+/// one state or the other: the fastest passes show what the code costs when it has the core to
+/// itself, the median and the 90th percentile what the run met.
+fn passes(kernels: &[PassKernel], rounds: usize) -> PassTimes {
+    let inputs: Vec<usize> = kernels.iter().map(|k| (k.pass)()).collect();
+    let mut ns: PassTimes = vec![Vec::with_capacity(rounds); kernels.len()];
+    for round in 0..rounds {
+        for j in 0..kernels.len() {
+            let k = (j + round) % kernels.len();
+            let start = Instant::now();
+            black_box((kernels[k].pass)());
+            ns[k].push(start.elapsed().as_nanos() as f64 / inputs[k].max(1) as f64);
+        }
+    }
+    ns
+}
+
+/// The pass-by-pass table: per kernel the fastest pass, the 10th, 50th and 90th percentiles (ns
+/// per input), the share of passes under its target, and the median ratio to its baseline's
+/// pass of the same round.
+fn passes_summary(kernels: &[PassKernel], times: &PassTimes) -> String {
+    let mut s = format!(
+        "Pass by pass ({PASS_ROUNDS} rounds of one pass of each kernel over its whole input, in \
+         turn; ns per input; ratios to the baseline's pass of the same round):\n\n\
+         | kernel | target | fastest | p10 | median | p90 | passes under target | median ratio \
+         to baseline |\n|---|---:|---:|---:|---:|---:|---:|---|\n"
+    );
+    let sorted = |v: &[f64]| {
+        let mut v = v.to_vec();
+        v.sort_by(f64::total_cmp);
+        v
+    };
+    for (k, kernel) in kernels.iter().enumerate() {
+        let t = sorted(&times[k]);
+        if t.is_empty() {
+            continue;
+        }
+        let (target, under) = if kernel.target_ns.is_finite() {
+            let n = t.iter().filter(|&&x| x < kernel.target_ns).count();
+            (
+                format!("{:.0}", kernel.target_ns),
+                format!("{:.0} %", 100.0 * n as f64 / t.len() as f64),
+            )
+        } else {
+            ("-".to_string(), "-".to_string())
+        };
+        let ratio = match kernels.iter().position(|x| x.name == kernel.baseline) {
+            Some(b) => {
+                let r: Vec<f64> = times[k].iter().zip(&times[b]).map(|(x, y)| x / y).collect();
+                format!("{:.2} (`{}`)", quantile(&sorted(&r), 0.5), kernel.baseline)
+            }
+            None => "-".to_string(),
+        };
+        let _ = writeln!(
+            s,
+            "| `{}` | {target} | {:.0} | {:.0} | {:.0} | {:.0} | {under} | {ratio} |",
+            kernel.name,
+            t[0],
+            quantile(&t, 0.1),
+            quantile(&t, 0.5),
+            quantile(&t, 0.9),
+        );
+    }
+    s
+}
+
 fn summary(rec: &Record, accuracy: &[String]) -> String {
     let mut s = String::new();
     s.push_str("| kernel | input | ns/input | baseline | baseline ns/input | ratio | target |\n");
@@ -1287,11 +1382,65 @@ fn main() {
             .sum::<usize>()
     });
 
+    // The kernels with an absolute target and their baselines, pass by pass.
+    let pass_kernels = [
+        PassKernel {
+            name: "ik/working_lanes",
+            baseline: "ik/newton_warm",
+            target_ns: 100.0,
+            pass: Box::new(|| {
+                fx.run_ik_lanes(&fx.path, |_, b| {
+                    black_box(module_ik::working(b));
+                });
+                n
+            }),
+        },
+        PassKernel {
+            name: "ik/all_branches_lanes",
+            baseline: "ik/newton_warm",
+            target_ns: 250.0,
+            pass: Box::new(|| {
+                black_box(fx.run_ik_all_lanes(&fx.path));
+                n
+            }),
+        },
+        PassKernel {
+            name: "ik/newton_warm",
+            baseline: "",
+            target_ns: f64::INFINITY,
+            pass: Box::new(|| {
+                black_box(fx.run_newton_ik());
+                n
+            }),
+        },
+        PassKernel {
+            name: "fk/all_modes",
+            baseline: "fk/newton_warm",
+            target_ns: 2000.0,
+            pass: Box::new(|| {
+                black_box(fx.run_fk_all(path_rho.iter().copied()));
+                n
+            }),
+        },
+        PassKernel {
+            name: "fk/newton_warm",
+            baseline: "",
+            target_ns: f64::INFINITY,
+            pass: Box::new(|| {
+                black_box(fx.run_newton_fk());
+                n
+            }),
+        },
+    ];
+    let pass_times = passes(&pass_kernels, PASS_ROUNDS);
+    let pass_text = passes_summary(&pass_kernels, &pass_times);
+    eprintln!("\n{pass_text}");
+
     c.final_summary();
     if rec.0.borrow().is_empty() {
         return;
     }
-    let text = summary(&rec, &accuracy);
+    let text = summary(&rec, &accuracy) + "\n" + &pass_text;
     println!("\n{text}");
     if let Some(path) = std::env::var_os("VERNE_BENCH_SUMMARY") {
         std::fs::write(&path, &text).expect("cannot write VERNE_BENCH_SUMMARY");
