@@ -88,6 +88,13 @@ impl Verdict {
         self.0 |= r.bit();
     }
 
+    /// The verdict whose reasons are the bits of `bits`, bit i for [`Reason`] i in declaration
+    /// order.
+    #[inline]
+    pub(crate) fn from_bits(bits: u16) -> Verdict {
+        Verdict(bits)
+    }
+
     /// The reasons of both.
     #[inline]
     pub fn with(self, other: Verdict) -> Verdict {

@@ -19,6 +19,8 @@ pub mod machine_rows;
 pub mod module_fk;
 pub mod module_geometry;
 pub mod module_ik;
+#[cfg(target_arch = "x86_64")]
+mod module_ik_x4;
 pub mod module_rows;
 pub mod orientation;
 pub mod pipeline;

@@ -21,6 +21,8 @@ use crate::cpu;
 use crate::cubic::{cubic_roots_in, deflated_roots_in};
 use crate::machine::{Machine, ModuleGeometry};
 use crate::module_geometry::Sliders;
+#[cfg(target_arch = "x86_64")]
+use crate::module_ik_x4;
 use crate::tolerance::{
     NEWTON_MAX_ITER, NEWTON_STEP_STOP, SAME_SOLUTION_RAD, SIN_ALPHA_ZERO, SQRT_ARG_REL,
 };
@@ -587,6 +589,17 @@ fn each_in_lanes_built<'a, const AVX2: bool, const EVERY: bool>(
                 leg1_postures_into(g, &pts[k], &roots[k], certified[k], &mut postures[k]);
             }
             for (k, out) in outs.enumerate() {
+                // Four postures (two roots of (9) and their mirror images, as on most points):
+                // their labels side by side in the AVX2 build.
+                #[cfg(target_arch = "x86_64")]
+                if AVX2 {
+                    if let Ok(four) = <&[Leg1; 4]>::try_from(postures[k].as_slice()) {
+                        // SAFETY: `AVX2` is set only in the build that runs where the
+                        // processor has AVX2 (`each_in_lanes`).
+                        unsafe { module_ik_x4::branches_into(m, &pts[k], four, out) };
+                        continue;
+                    }
+                }
                 branches_into(m, &pts[k], &postures[k], out);
             }
         },
@@ -626,7 +639,6 @@ fn branches_into(m: &Machine, p: &Vector3<f64>, legs1: &ArrayVec<Leg1, 6>, out: 
     let cos_tilt = cos_tilt_max(m);
     // Leg I's label per posture; legs II and III once per cos(alpha): a posture and its mirror
     // image (next to each other in `legs1`) share them.
-    let n = legs1.len();
     let mut checks = [(0i8, Verdict::default()); 6];
     let mut outer = [None; 6];
     for (k, l) in legs1.iter().enumerate() {
@@ -637,36 +649,9 @@ fn branches_into(m: &Machine, p: &Vector3<f64>, legs1: &ArrayVec<Leg1, 6>, out: 
             outer_legs(m, p, l.cos, cos_tilt)
         };
     }
-    // Branches come out ordered by alpha, then (s1, s2, s3): postures sorted by (alpha, s1), and
-    // within a posture s2, s3 = -1 before +1 (the roots of (12)-(13) in increasing order).
-    // Postures come in pairs (alpha >= 0, its mirror) by increasing cos(alpha): the mirrors in
-    // that order, then the others in reverse, is usually the order already; sorted if not.
-    let mut order = [0usize; 6];
-    let (mut front, mut back) = (0, n);
-    for k in 0..n {
-        if legs1[k].alpha < 0.0 {
-            order[front] = k;
-            front += 1;
-        } else {
-            back -= 1;
-            order[back] = k;
-        }
-    }
-    let order = &mut order[..n];
-    let in_order = order.windows(2).all(|w| {
-        listed_in_order(
-            (legs1[w[0]].alpha, checks[w[0]].0),
-            (legs1[w[1]].alpha, checks[w[1]].0),
-        )
-    });
-    if !in_order {
-        let key = |k: usize| (legs1[k].alpha, checks[k].0);
-        order.sort_unstable_by(|&a, &b| {
-            let (ka, kb) = (key(a), key(b));
-            ka.0.total_cmp(&kb.0).then(ka.1.cmp(&kb.1))
-        });
-    }
-    for &k in order.iter() {
+    let s1: [i8; 6] = std::array::from_fn(|k| checks[k].0);
+    let (order, n) = posture_order(legs1, &s1);
+    for &k in &order[..n] {
         if let Some(o) = &outer[k] {
             let four = four_branches(m, p, &legs1[k], checks[k], o);
             let pushed = out.try_extend_from_slice(&four);
@@ -676,6 +661,40 @@ fn branches_into(m: &Machine, p: &Vector3<f64>, legs1: &ArrayVec<Leg1, 6>, out: 
             );
         }
     }
+}
+
+/// The order in which the branches of the leg-I postures `legs1` come out, with their leg-I
+/// configuration indices `s1`: the first `legs1.len()` entries, indices into `legs1`.
+/// Branches come out ordered by alpha, then (s1, s2, s3): postures sorted by (alpha, s1), and
+/// within a posture s2, s3 = -1 before +1 (the roots of (12)-(13) in increasing order).
+/// Postures come in pairs (alpha >= 0, its mirror) by increasing cos(alpha): the mirrors in
+/// that order, then the others in reverse, is usually the order already; sorted if not.
+#[inline(always)]
+pub(crate) fn posture_order(legs1: &[Leg1], s1: &[i8; 6]) -> ([usize; 6], usize) {
+    let n = legs1.len().min(6);
+    let mut order = [0usize; 6];
+    let (mut front, mut back) = (0, n);
+    for (k, leg1) in legs1[..n].iter().enumerate() {
+        if leg1.alpha < 0.0 {
+            order[front] = k;
+            front += 1;
+        } else {
+            back -= 1;
+            order[back] = k;
+        }
+    }
+    let listed = &mut order[..n];
+    let in_order = listed
+        .windows(2)
+        .all(|w| listed_in_order((legs1[w[0]].alpha, s1[w[0]]), (legs1[w[1]].alpha, s1[w[1]])));
+    if !in_order {
+        let key = |k: usize| (legs1[k].alpha, s1[k]);
+        listed.sort_unstable_by(|&a, &b| {
+            let (ka, kb) = (key(a), key(b));
+            ka.0.total_cmp(&kb.0).then(ka.1.cmp(&kb.1))
+        });
+    }
+    (order, n)
 }
 
 /// Legs II and III at a leg-I posture as far as they depend on its cos(alpha) alone (a posture

@@ -415,6 +415,57 @@ fn solve_each_gives_solves_lists() {
     }
 }
 
+/// Every reason a branch can be refused for comes out of `module_ik::solve_each` as out of
+/// `module_ik::solve`, bit for bit, on points with four leg-I postures (their labels come four
+/// side by side in the AVX2 build, `module_ik_x4`): on the default machine and on one with
+/// strokes 100-200 mm narrower at each end, each slider its own, and a rod-tilt limit beyond
+/// 90 degrees (the other form of the tilt test).
+#[test]
+fn solve_each_labels_four_postures_as_solve_does() {
+    use verne::branches::Reason;
+    let mut other = Machine::default_verne();
+    for (j, (lo, hi)) in [(150.0, 150.0), (100.0, 200.0), (200.0, 100.0)]
+        .into_iter()
+        .enumerate()
+    {
+        other.limits.rho_min[j] += lo;
+        other.limits.rho_max[j] -= hi;
+    }
+    other.limits.cos_rod_tilt_max = 100f64.to_radians().cos();
+    for (name, m) in [("default", Machine::default_verne()), ("other", other)] {
+        let mut pts = helix_points(1024);
+        pts.extend(random_points(31, 30_000));
+        let mut got = vec![IkBranches::new(); pts.len()];
+        module_ik::solve_each(&m, pts.iter().copied().zip(got.iter_mut()));
+        let mut seen = std::collections::BTreeSet::new();
+        let mut four = 0;
+        for (p, got) in pts.iter().zip(&got) {
+            let expected = module_ik::solve(&m, p);
+            let bits = |list: &IkBranches| list.iter().map(branch_bits).collect::<Vec<_>>();
+            assert_eq!(bits(got), bits(&expected), "{name}: p={p:?}");
+            if got.len() == 16 {
+                four += 1;
+                seen.extend(
+                    got.iter()
+                        .flat_map(|b| b.verdict.reasons())
+                        .map(|r| r.code()),
+                );
+            }
+        }
+        assert!(four > 3_000, "{name}: {four} points with sixteen branches");
+        for r in Reason::ALL
+            .into_iter()
+            .filter(|r| *r != Reason::Theta1Range)
+        {
+            assert!(
+                seen.contains(r.code()),
+                "{name}: no branch with {}",
+                r.code()
+            );
+        }
+    }
+}
+
 /// `module_ik::solve_working_each` (as `verne ik`) gives the lists of its baseline x86-64 build
 /// bit for bit (it runs the AVX2 build where the processor has AVX2).
 #[test]
