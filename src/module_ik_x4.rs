@@ -36,20 +36,14 @@ pub(crate) unsafe fn branches_into(
     }
     // SAFETY: the caller guarantees AVX2 (and with it AVX).
     let lanes = unsafe { PostureLanes::new(m, p, legs1) };
-    let s1: [i8; 6] = std::array::from_fn(|k| lanes.sign(lanes.inverted1, k));
+    let s1: [i8; 6] = std::array::from_fn(|k| if k < 4 { lanes.s1[k] as i8 } else { -1 });
     let (order, n) = posture_order(legs1, &s1);
     for &k in &order[..n] {
         if lanes.reach >> k & 1 == 0 {
             continue;
         }
-        let s2 = [
-            lanes.sign(lanes.inverted2[0], k),
-            lanes.sign(lanes.inverted2[1], k),
-        ];
-        let s3 = [
-            lanes.sign(lanes.inverted3[0], k),
-            lanes.sign(lanes.inverted3[1], k),
-        ];
+        let s2 = [lanes.s2[0][k] as i8, lanes.s2[1][k] as i8];
+        let s3 = [lanes.s3[0][k] as i8, lanes.s3[1][k] as i8];
         let leg1 = &legs1[k];
         let branch = |k2: usize, k3: usize| IkBranch {
             alpha: leg1.alpha,
@@ -70,11 +64,10 @@ pub(crate) unsafe fn branches_into(
 struct PostureLanes {
     /// Bit k: legs II and III both reach at posture k (eqs. (12)-(13) have real roots).
     reach: u32,
-    /// Bit k: s1 = +1 (rho1 - zp above [`CONFIG_SIGN_MM`]).
-    inverted1: u32,
-    /// [lower root, upper root], bit k: s2 = +1, and s3 = +1.
-    inverted2: [u32; 2],
-    inverted3: [u32; 2],
+    /// s1 (+1 or -1) of each posture, and s2 and s3 at the [lower, upper] roots of (12)-(13).
+    s1: [i64; 4],
+    s2: [[i64; 4]; 2],
+    s3: [[i64; 4]; 2],
     /// rho2 and rho3 at the [lower, upper] roots of (12)-(13).
     rho2: [[f64; 4]; 2],
     rho3: [[f64; 4]; 2],
@@ -84,12 +77,6 @@ struct PostureLanes {
 }
 
 impl PostureLanes {
-    /// +1 or -1 from bit k of `inverted`.
-    #[inline(always)]
-    fn sign(&self, inverted: u32, k: usize) -> i8 {
-        if inverted >> k & 1 != 0 { 1 } else { -1 }
-    }
-
     /// # Safety
     /// The processor must have AVX2.
     #[target_feature(enable = "avx2")]
@@ -232,12 +219,21 @@ impl PostureLanes {
                 _mm256_storeu_pd(v.as_mut_ptr(), a);
                 v
             };
-            let mask = |a| _mm256_movemask_pd(a) as u32;
+            // s_i = +1 where inverted (all ones: 2 - 1), else -1 (0 - 1).
+            let sign = |inverted: __m256d| {
+                let two = _mm256_and_si256(_mm256_castpd_si256(inverted), _mm256_set1_epi64x(2));
+                let mut v = [0i64; 4];
+                _mm256_storeu_si256(
+                    v.as_mut_ptr().cast(),
+                    _mm256_sub_epi64(two, _mm256_set1_epi64x(1)),
+                );
+                v
+            };
             PostureLanes {
                 reach,
-                inverted1: mask(inverted1),
-                inverted2: [mask(inverted2[0]), mask(inverted2[1])],
-                inverted3: [mask(inverted3[0]), mask(inverted3[1])],
+                s1: sign(inverted1),
+                s2: [sign(inverted2[0]), sign(inverted2[1])],
+                s3: [sign(inverted3[0]), sign(inverted3[1])],
                 rho2: [store(rho2[0]), store(rho2[1])],
                 rho3: [store(rho3[0]), store(rho3[1])],
                 verdict,
