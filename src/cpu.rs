@@ -9,7 +9,9 @@
 //! needs: a third fewer instructions for the working branch, 15 % fewer for every branch, a
 //! fifth fewer for the FK (docs/benchmarks.md). Both builds give the same results bit for bit
 //! (Rust neither fuses nor reorders floating-point operations, whatever the instruction set);
-//! the tests compare them.
+//! the tests compare them. The AVX2 build of `solve_each` also labels a point's four leg-I
+//! postures side by side with AVX intrinsics (`module_ik_x4`), the same operations lane by lane,
+//! where the baseline build labels them one by one.
 //!
 //! The pattern (`module_ik::each_in_lanes`): one dispatcher checks [`has_avx2`] and calls a
 //! function marked `#[target_feature(enable = "avx2")]` or the baseline one; both inline one
