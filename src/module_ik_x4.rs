@@ -191,24 +191,36 @@ impl PostureLanes {
                 ),
                 ori(bit(tilted1, tilt), bit(cross, Reason::RodsCross)),
             );
-            let v2: [__m256i; 2] = std::array::from_fn(|j| {
-                ori(
-                    ori(
-                        bit(inverted2[j], Reason::Leg2Inverted),
-                        bit(tilted2[j], tilt),
-                    ),
-                    bit(outside(rho2[j], 1), Reason::Rho2Stroke),
-                )
-            });
-            let v3: [__m256i; 2] = std::array::from_fn(|j| {
-                ori(
-                    ori(
-                        bit(inverted3[j], Reason::Leg3Inverted),
-                        bit(tilted3[j], tilt),
-                    ),
-                    bit(outside(rho3[j], 2), Reason::Rho3Stroke),
-                )
-            });
+            // Leg II or III (slider `leg`, 1 or 2) at its [lower, upper] root. Closures are
+            // called directly: through `array::map` they stay calls, outside the AVX2 context.
+            let outer_verdict =
+                |inverted: [__m256d; 2],
+                 tilted: [__m256d; 2],
+                 rho: [__m256d; 2],
+                 leg: usize,
+                 (inverted_reason, stroke_reason): (Reason, Reason)| {
+                    let verdict = |j: usize| {
+                        ori(
+                            ori(bit(inverted[j], inverted_reason), bit(tilted[j], tilt)),
+                            bit(outside(rho[j], leg), stroke_reason),
+                        )
+                    };
+                    [verdict(0), verdict(1)]
+                };
+            let v2 = outer_verdict(
+                inverted2,
+                tilted2,
+                rho2,
+                1,
+                (Reason::Leg2Inverted, Reason::Rho2Stroke),
+            );
+            let v3 = outer_verdict(
+                inverted3,
+                tilted3,
+                rho3,
+                2,
+                (Reason::Leg3Inverted, Reason::Rho3Stroke),
+            );
             let mut verdict = [[0u64; 4]; 4];
             for (b, v) in verdict.iter_mut().enumerate() {
                 let both = ori(v1, ori(v2[b / 2], v3[b % 2]));
