@@ -1087,14 +1087,26 @@ const PARTS: &[(&str, &str)] = &[
 /// kernel over its whole input (about 10 ms a round).
 const PASS_ROUNDS: usize = 600;
 
-/// A kernel timed pass by pass: its name in the main table, its baseline's ("" for none), the
-/// target it answers to (ns per input; infinite for none), and one pass over its input (returns
-/// the inputs handled).
+/// A kernel timed pass by pass: its name in the main table, the target it answers to (ns per
+/// input) with its baseline's name (None for a baseline), and one pass over the path.
 struct PassKernel<'a> {
     name: &'static str,
-    baseline: &'static str,
-    target_ns: f64,
-    pass: Box<dyn Fn() -> usize + 'a>,
+    target: Option<(f64, &'static str)>,
+    pass: Box<dyn Fn() + 'a>,
+}
+
+impl<'a> PassKernel<'a> {
+    fn new(
+        name: &'static str,
+        target: Option<(f64, &'static str)>,
+        pass: impl Fn() + 'a,
+    ) -> PassKernel<'a> {
+        PassKernel {
+            name,
+            target,
+            pass: Box::new(pass),
+        }
+    }
 }
 
 /// ns per input of every pass of every kernel, in the order of the kernels.
@@ -1113,15 +1125,18 @@ fn quantile(v: &[f64], q: f64) -> f64 {
 /// two states in whatever share the run met. Single passes of about a millisecond mostly fall in
 /// one state or the other: the fastest passes show what the code costs when it has the core to
 /// itself, the median and the 90th percentile what the run met.
-fn passes(kernels: &[PassKernel], rounds: usize) -> PassTimes {
-    let inputs: Vec<usize> = kernels.iter().map(|k| (k.pass)()).collect();
+/// Each pass handles `rows` inputs.
+fn passes(kernels: &[PassKernel], rows: usize, rounds: usize) -> PassTimes {
+    for k in kernels {
+        (k.pass)();
+    }
     let mut ns: PassTimes = vec![Vec::with_capacity(rounds); kernels.len()];
     for round in 0..rounds {
         for j in 0..kernels.len() {
             let k = (j + round) % kernels.len();
             let start = Instant::now();
-            black_box((kernels[k].pass)());
-            ns[k].push(start.elapsed().as_nanos() as f64 / inputs[k].max(1) as f64);
+            (kernels[k].pass)();
+            ns[k].push(start.elapsed().as_nanos() as f64 / rows.max(1) as f64);
         }
     }
     ns
@@ -1147,22 +1162,17 @@ fn passes_summary(kernels: &[PassKernel], times: &PassTimes) -> String {
         if t.is_empty() {
             continue;
         }
-        let (target, under) = if kernel.target_ns.is_finite() {
-            let n = t.iter().filter(|&&x| x < kernel.target_ns).count();
-            (
-                format!("{:.0}", kernel.target_ns),
-                format!("{:.0} %", 100.0 * n as f64 / t.len() as f64),
-            )
-        } else {
-            ("-".to_string(), "-".to_string())
-        };
-        let ratio = match kernels.iter().position(|x| x.name == kernel.baseline) {
-            Some(b) => {
+        let (mut target, mut under, mut ratio) =
+            ("-".to_string(), "-".to_string(), "-".to_string());
+        if let Some((target_ns, baseline)) = kernel.target {
+            let n = t.iter().filter(|&&x| x < target_ns).count();
+            target = format!("{target_ns:.0}");
+            under = format!("{:.0} %", 100.0 * n as f64 / t.len() as f64);
+            if let Some(b) = kernels.iter().position(|x| x.name == baseline) {
                 let r: Vec<f64> = times[k].iter().zip(&times[b]).map(|(x, y)| x / y).collect();
-                format!("{:.2} (`{}`)", quantile(&sorted(&r), 0.5), kernel.baseline)
+                ratio = format!("{:.2} (`{baseline}`)", quantile(&sorted(&r), 0.5));
             }
-            None => "-".to_string(),
-        };
+        }
         let _ = writeln!(
             s,
             "| `{}` | {target} | {:.0} | {:.0} | {:.0} | {:.0} | {under} | {ratio} |",
@@ -1384,55 +1394,29 @@ fn main() {
 
     // The kernels with an absolute target and their baselines, pass by pass.
     let pass_kernels = [
-        PassKernel {
-            name: "ik/working_lanes",
-            baseline: "ik/newton_warm",
-            target_ns: 100.0,
-            pass: Box::new(|| {
-                fx.run_ik_lanes(&fx.path, |_, b| {
-                    black_box(module_ik::working(b));
-                });
-                n
-            }),
-        },
-        PassKernel {
-            name: "ik/all_branches_lanes",
-            baseline: "ik/newton_warm",
-            target_ns: 250.0,
-            pass: Box::new(|| {
+        PassKernel::new("ik/working_lanes", Some((100.0, "ik/newton_warm")), || {
+            fx.run_ik_lanes(&fx.path, |_, b| {
+                black_box(module_ik::working(b));
+            })
+        }),
+        PassKernel::new(
+            "ik/all_branches_lanes",
+            Some((250.0, "ik/newton_warm")),
+            || {
                 black_box(fx.run_ik_all_lanes(&fx.path));
-                n
-            }),
-        },
-        PassKernel {
-            name: "ik/newton_warm",
-            baseline: "",
-            target_ns: f64::INFINITY,
-            pass: Box::new(|| {
-                black_box(fx.run_newton_ik());
-                n
-            }),
-        },
-        PassKernel {
-            name: "fk/all_modes",
-            baseline: "fk/newton_warm",
-            target_ns: 2000.0,
-            pass: Box::new(|| {
-                black_box(fx.run_fk_all(path_rho.iter().copied()));
-                n
-            }),
-        },
-        PassKernel {
-            name: "fk/newton_warm",
-            baseline: "",
-            target_ns: f64::INFINITY,
-            pass: Box::new(|| {
-                black_box(fx.run_newton_fk());
-                n
-            }),
-        },
+            },
+        ),
+        PassKernel::new("ik/newton_warm", None, || {
+            black_box(fx.run_newton_ik());
+        }),
+        PassKernel::new("fk/all_modes", Some((2000.0, "fk/newton_warm")), || {
+            black_box(fx.run_fk_all(path_rho.iter().copied()));
+        }),
+        PassKernel::new("fk/newton_warm", None, || {
+            black_box(fx.run_newton_fk());
+        }),
     ];
-    let pass_times = passes(&pass_kernels, PASS_ROUNDS);
+    let pass_times = passes(&pass_kernels, n, PASS_ROUNDS);
     let pass_text = passes_summary(&pass_kernels, &pass_times);
     eprintln!("\n{pass_text}");
 
