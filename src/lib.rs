@@ -7,11 +7,15 @@ pub mod arg_values;
 pub mod branches;
 pub mod cpu;
 pub mod cubic;
+pub mod dd;
 pub mod error;
+pub mod fk_certify;
 #[doc(hidden)]
 pub mod fk_track;
 pub mod fuzz_entry;
 pub mod glider;
+pub mod hard_sets;
+pub mod interval;
 pub mod jacobian;
 pub mod machine;
 pub mod machine_kin;
@@ -26,6 +30,7 @@ pub mod orientation;
 pub mod pipeline;
 pub mod plot;
 pub mod poly;
+pub mod scalar;
 pub mod selftest;
 pub mod table;
 #[cfg(test)]

@@ -30,6 +30,7 @@ use nalgebra::{Matrix3, Vector3};
 
 use crate::branches::{Config, Verdict, label};
 use crate::cpu;
+use crate::fk_certify::{self, ProvedStart, Resolution};
 use crate::machine::{Machine, ModuleGeometry};
 use crate::module_geometry::{ModulePose, Sliders, polish_pose_from, residual_mm};
 use crate::module_ik::wrap_angle;
@@ -40,8 +41,48 @@ use crate::trig::Trig;
 /// |b| there is below this fraction of its coefficients (a solution needs b = 0).
 const DET_ZERO_B_REL: f64 = 1e-6;
 
+/// How far (rad) the Newton polish may move alpha from a proved root: the root is accurate to
+/// rounding, so a mode farther than this is some other root's.
+const ROOT_POLISH_RAD: f64 = 1e-6;
+
 /// Most assembly modes returned (the degree-8 polynomial, plus degenerate doubled solutions).
 pub const MAX_FK_MODES: usize = 16;
+
+/// What proves that the assembly modes returned are all the real ones (module documentation).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Default, Hash)]
+pub enum Certificate {
+    /// Every real root of F isolated in double precision, each proved simple, with a bound on
+    /// the rounding of F's coefficients and of its evaluation; every other angle proved not a
+    /// root; each root gave its mode.
+    #[default]
+    Double,
+    /// As [`Certificate::Double`], except on intervals next to a zero of condition (21), where
+    /// two modes share nearly the same alpha: there the roots of the two factors of F were
+    /// proved by interval arithmetic ([`crate::fk_certify`]).
+    Factored,
+    /// Some interval needed the degree-8 polynomial in double-double precision.
+    Extended,
+    /// Some interval of alpha could be decided by none of the methods: the modes returned are
+    /// what was found, not proved complete (status `uncertified`).
+    Unproved,
+}
+
+impl Certificate {
+    /// True unless [`Certificate::Unproved`].
+    pub fn proved(self) -> bool {
+        self != Certificate::Unproved
+    }
+
+    /// Its name in reports: `double`, `factored`, `extended`, `unproved`.
+    pub fn code(self) -> &'static str {
+        match self {
+            Certificate::Double => "double",
+            Certificate::Factored => "factored",
+            Certificate::Extended => "extended",
+            Certificate::Unproved => "unproved",
+        }
+    }
+}
 
 /// One assembly mode.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -57,7 +98,49 @@ impl FkMode {
     }
 }
 
-pub type FkModes = ArrayVec<FkMode, MAX_FK_MODES>;
+/// Every real assembly mode of one set of slider positions, with the certificate that says why
+/// there are no others. Dereferences to the list of modes.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct FkModes {
+    modes: ArrayVec<FkMode, MAX_FK_MODES>,
+    /// How completeness was proved, or that it was not.
+    pub certificate: Certificate,
+}
+
+impl FkModes {
+    pub fn new() -> FkModes {
+        FkModes::default()
+    }
+}
+
+impl std::ops::Deref for FkModes {
+    type Target = ArrayVec<FkMode, MAX_FK_MODES>;
+    fn deref(&self) -> &Self::Target {
+        &self.modes
+    }
+}
+
+impl std::ops::DerefMut for FkModes {
+    fn deref_mut(&mut self) -> &mut Self::Target {
+        &mut self.modes
+    }
+}
+
+impl IntoIterator for FkModes {
+    type Item = FkMode;
+    type IntoIter = arrayvec::IntoIter<FkMode, MAX_FK_MODES>;
+    fn into_iter(self) -> Self::IntoIter {
+        self.modes.into_iter()
+    }
+}
+
+impl<'a> IntoIterator for &'a FkModes {
+    type Item = &'a FkMode;
+    type IntoIter = std::slice::Iter<'a, FkMode>;
+    fn into_iter(self) -> Self::IntoIter {
+        self.modes.iter()
+    }
+}
 
 /// The linear trigonometric forms of the elimination for one set of slider positions.
 struct Elimination {
@@ -283,25 +366,38 @@ fn solve_built<const AVX2: bool>(m: &Machine, rho: &Sliders) -> FkModes {
     }
     let elim = Elimination::new(g, rho);
     let f = elim.characteristic(g);
-    // Starting poses, each with (sin alpha, cos alpha).
-    let mut starts: ArrayVec<(ModulePose, (f64, f64)), 68> = ArrayVec::new();
-    for root in &f.roots_sin_cos_built::<AVX2>() {
+    let iso = f.isolate_built::<AVX2>(fk_certify::characteristic_error(g, rho), true);
+    // One start pose per proved root (each root of F gives exactly one mode where Det != 0;
+    // next to a zero of Det the factor it belongs to gives it), each with (sin, cos) of alpha.
+    let mut proved: ArrayVec<ProvedStart, 40> = ArrayVec::new();
+    for root in &iso.roots {
         let (alpha, sc) = (root.x, (root.sin, root.cos));
-        match elim.back_substitute(g, rho, alpha, sc) {
-            Some(p) => starts.push((p, sc)),
-            None => starts.extend(
-                fixed_alpha_points(g, rho, alpha, sc)
-                    .into_iter()
-                    .map(|p| (p, sc)),
-            ),
+        let pose = elim
+            .back_substitute(g, rho, alpha, sc)
+            .or_else(|| fk_certify::pose_at_root_by_factors(g, rho, alpha, sc));
+        match pose {
+            Some(pose) => {
+                let _ = proved.try_push(ProvedStart { pose, sc });
+            }
+            None => out.certificate = Certificate::Unproved,
         }
     }
+    // Other starts: what the proof does not predict (any mode they find that the proved roots
+    // did not is a contradiction, and the result is then unproved).
+    let mut others: ArrayVec<ProvedStart, 40> = ArrayVec::new();
+    if !iso.ambiguous.is_empty() {
+        let resolution = fk_certify::resolve(g, rho, &iso.ambiguous, &mut proved, &mut others);
+        out.certificate = out.certificate.max(match resolution {
+            Resolution::Factored => Certificate::Factored,
+            Resolution::Extended => Certificate::Extended,
+            Resolution::Unproved => Certificate::Unproved,
+        });
+    }
     // Where condition (21) fails (Det = 0), a real solution forces b = 0 there and F then has
-    // (at least) a double root, F = 4 b^2 (Q^2 + delta^2 (R1^2 + r1^2 - 2 R1 r1 c)) >= 0, which
-    // floating-point root isolation can miss (it happens on a whole plane: L2 = L3, rho2 = rho3,
-    // alpha = 0, y_p = 0). Those (at most two) angles are tried directly on the four spheres,
-    // keeping only points that already solve them (elsewhere Newton could wander from these
-    // least-squares points and stop, unconverged, next to a solution found above).
+    // (at least) a double root, F = 4 b^2 (Q^2 + delta^2 (R1^2 + r1^2 - 2 R1 r1 c)) >= 0 (it
+    // happens on a whole plane: L2 = L3, rho2 = rho3, alpha = 0, y_p = 0). Those (at most two)
+    // angles are tried directly on the four spheres, keeping only points that already solve
+    // them: a cross-check of the proof, which finds these modes as roots of the factors.
     let b_scale = elim.b.cos[0].abs() + elim.b.sin[1].abs();
     for sc in det_zeros(&elim.det) {
         // F = 4 b^2 (Q^2 + delta^2 N) > 0 there unless b = 0: no solution at this alpha.
@@ -309,16 +405,25 @@ fn solve_built<const AVX2: bool>(m: &Machine, rho: &Sliders) -> FkModes {
             continue;
         }
         let alpha = wrap_angle(sc.0.atan2(sc.1));
-        let on_spheres = fixed_alpha_points(g, rho, alpha, sc)
-            .into_iter()
-            .filter(|p| residual_mm(g, p, rho) <= ACCEPT_RESIDUAL_MM)
-            .map(|p| (p, sc));
-        starts.extend(on_spheres);
+        for pose in fixed_alpha_points(g, rho, alpha, sc) {
+            if residual_mm(g, &pose, rho) <= ACCEPT_RESIDUAL_MM {
+                let _ = others.try_push(ProvedStart { pose, sc });
+            }
+        }
     }
-    for &(start, sc) in &starts {
-        let (pose, residual, (s, c)) = polish_pose_from(g, start, sc, rho);
+    let n_proved = proved.len();
+    for (k, start) in proved.iter().chain(&others).enumerate() {
+        let (pose, residual, (s, c)) = polish_pose_from(g, start.pose, start.sc, rho);
         if residual > ACCEPT_RESIDUAL_MM {
+            if k < n_proved {
+                // A proved root whose mode could not be polished: not proved after all.
+                out.certificate = Certificate::Unproved;
+            }
             continue;
+        }
+        if k < n_proved && wrap_angle(pose.alpha - start.pose.alpha).abs() > ROOT_POLISH_RAD {
+            // The polish left its root's neighbourhood: the mode it found is not that root's.
+            out.certificate = Certificate::Unproved;
         }
         let pose = ModulePose {
             alpha: wrap_angle(pose.alpha),
@@ -328,8 +433,15 @@ fn solve_built<const AVX2: bool>(m: &Machine, rho: &Sliders) -> FkModes {
             wrap_angle(o.pose.alpha - pose.alpha).abs() < SAME_SOLUTION_RAD
                 && (o.pose.p - pose.p).amax() < SAME_SOLUTION_MM * (1.0 + pose.p.amax())
         });
-        if dup || out.is_full() {
+        if dup {
             continue;
+        }
+        if k >= n_proved || out.is_full() {
+            // A mode no proved root predicted (or more than the list holds).
+            out.certificate = Certificate::Unproved;
+            if out.is_full() {
+                continue;
+            }
         }
         // wrap_angle moves alpha by whole turns at most: the same sine and cosine.
         let (config, verdict) = label(m, &pose.p, s, c, rho);

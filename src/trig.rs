@@ -268,30 +268,63 @@ impl Trig {
     pub(crate) fn roots_sin_cos_built<const AVX2: bool>(
         &self,
     ) -> ArrayVec<TrigRoot, MAX_TRIG_ROOTS> {
+        self.isolate_built::<AVX2>(0.0, false).roots
+    }
+
+    /// Every real root in [-pi, pi] that can be proved, and the intervals where none can be
+    /// proved or excluded in double precision ([`Isolated`]). `coef_err` bounds the error of
+    /// the coefficients themselves (|p(x) - exact(x)| <= coef_err for every x, from the rounding
+    /// of the formulas that computed them): the proofs hold for the exact polynomial. Built with
+    /// AVX2 where the processor has it ([`crate::cpu`]).
+    pub fn roots_certified(&self, coef_err: f64) -> Isolated {
+        #[cfg(target_arch = "x86_64")]
+        if crate::cpu::has_avx2() {
+            // SAFETY: the processor has AVX2 (checked just above).
+            return unsafe { roots_certified_avx2(self, coef_err) };
+        }
+        self.isolate_built::<false>(coef_err, true)
+    }
+
+    /// The body of [`Trig::roots_sin_cos`] and [`Trig::roots_certified`], inlined into each
+    /// build. With `certify`, an interval no test decides is returned as ambiguous instead of
+    /// handed to the half-angle charts.
+    #[inline(always)]
+    pub(crate) fn isolate_built<const AVX2: bool>(&self, coef_err: f64, certify: bool) -> Isolated {
         let scale = self
             .cos
             .iter()
             .chain(&self.sin)
             .fold(0.0f64, |m, a| m.max(a.abs()));
-        if scale == 0.0 || !scale.is_finite() {
-            return ArrayVec::new();
+        if scale == 0.0 || !scale.is_finite() || !coef_err.is_finite() {
+            let mut out = Isolated::default();
+            if certify && !(scale == 0.0 && coef_err == 0.0) {
+                // Not finite, or zero only within the coefficients' error: nothing is proved.
+                out.ambiguous
+                    .push([-std::f64::consts::PI, std::f64::consts::PI]);
+            }
+            return out;
         }
         let f = self.scale(1.0 / scale);
         let d = f.derivative();
         let s = d.derivative();
+        // The coefficients' own error moves p by at most `ce`, p' by 4 ce, p'' by 16 ce, ...
+        // (each harmonic k scales by k per derivative): every bound below covers the exact
+        // polynomial as well as the computed one.
+        let ce = coef_err / scale;
         let mut iso = Isolation {
             f,
             d,
             s,
-            m2: s.harmonic_bound(0),
-            m3: s.harmonic_bound(1),
-            m4: s.harmonic_bound(2),
-            ef: f.eval_error(),
-            ed: d.eval_error(),
-            es: s.eval_error(),
+            m2: s.harmonic_bound(0) + 16.0 * ce,
+            m3: s.harmonic_bound(1) + 64.0 * ce,
+            m4: s.harmonic_bound(2) + 256.0 * ce,
+            ef: f.eval_error() + ce,
+            ed: d.eval_error() + 4.0 * ce,
+            es: s.eval_error() + 16.0 * ce,
             out: ArrayVec::new(),
             orig: *self,
             charts: [None, None],
+            ambiguous: certify.then(ArrayVec::new),
         };
         // F on the whole grid; F' and F'' only at the ends of the intervals that F alone does not
         // prove root-free (few: about two per root).
@@ -324,12 +357,19 @@ impl Trig {
             let (a, b) = (pt(j), pt(j + 1));
             let found = iso.out.len();
             let near_zero = a.f.abs() <= iso.ef || b.f.abs() <= iso.ef;
-            if near_zero || iso.interval::<AVX2>(a, b, 0).is_none() {
+            if near_zero && iso.ambiguous.is_some() {
+                iso.give_up(a.x, b.x);
+            } else if near_zero || iso.interval::<AVX2>(a, b, 0).is_none() {
                 iso.out.truncate(found);
                 iso.chart_roots(a.x, b.x);
             }
         }
-        iso.out
+        let ambiguous = iso.ambiguous.unwrap_or_default();
+        let mut roots = iso.out;
+        // A full list of ambiguous intervals grows its last one over what follows: the roots
+        // found there are the caller's to find again.
+        roots.retain(|r| !ambiguous.iter().any(|[lo, hi]| r.x >= *lo && r.x <= *hi));
+        Isolated { roots, ambiguous }
     }
 
     /// (1 + t^2)^4 p(x) as a polynomial in t = tan((x - shift)/2), shift in {0, pi}: the
@@ -357,6 +397,21 @@ pub struct TrigRoot {
     pub x: f64,
     pub sin: f64,
     pub cos: f64,
+}
+
+/// Most intervals [`Trig::roots_certified`] leaves undecided (each holds a close pair or
+/// a multiple root; more would only come from a polynomial that is zero within rounding).
+pub const MAX_AMBIGUOUS: usize = 4;
+
+/// What [`Trig::roots_certified`] proves: the roots it isolated (each simple, each proved to be
+/// the only root of the exact polynomial in an interval where the polynomial changes sign), in
+/// increasing order, and the intervals [lo, hi] it could neither prove root-free nor isolate
+/// (closed, disjoint, in increasing order; the roots are outside them). Every other point of
+/// [-pi, pi] is proved not to be a root.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Isolated {
+    pub roots: ArrayVec<TrigRoot, MAX_TRIG_ROOTS>,
+    pub ambiguous: ArrayVec<[f64; 2], MAX_AMBIGUOUS>,
 }
 
 /// Most roots [`Trig::roots`] returns: 2 [`MAX_HARMONIC`] simple roots, plus candidates at
@@ -454,6 +509,8 @@ struct Isolation {
     /// The polynomial as given, and its half-angle charts (computed when needed).
     orig: Trig,
     charts: [Option<Coeffs>; 2],
+    /// In certifying mode ([`Trig::roots_certified`]), the intervals given up on.
+    ambiguous: Option<ArrayVec<[f64; 2], MAX_AMBIGUOUS>>,
 }
 
 impl Isolation {
@@ -567,22 +624,75 @@ impl Isolation {
                     self.critical::<AVX2>(a, b)
                 };
                 if c.f.abs() <= self.ef {
-                    return None;
+                    // Outside certifying mode the caller hands the interval to the charts.
+                    self.ambiguous.as_ref()?;
+                    // Only near c can F come within rounding of zero (two close roots, or a
+                    // double one): the rest of [a, b] is proved root-free.
+                    let (lo, hi) = self.band_around(a, c, b);
+                    return self.give_up(lo, hi);
                 }
                 self.monotone::<AVX2>(a, c);
                 self.monotone::<AVX2>(c, b);
-            } else {
-                // F' monotone and not changing sign beyond rounding: F monotone.
+                return Some(());
+            } else if self.ambiguous.is_none() || same_sign_beyond(a.d, b.d, self.ed) {
+                // F' monotone and not changing sign beyond rounding: F monotone. (Where an end
+                // of F' is within rounding of zero, F could turn there: a proof bisects.)
                 self.monotone::<AVX2>(a, b);
+                return Some(());
             }
-            return Some(());
         }
-        let m = self.at(0.5 * (a.x + b.x));
+        let mut m = self.at(0.5 * (a.x + b.x));
+        if m.f.abs() <= self.ef && self.ambiguous.is_some() {
+            // A proof needs split points where F is beyond rounding: try off-centre ones.
+            for frac in [0.3, 0.7] {
+                let p = self.at(a.x + frac * (b.x - a.x));
+                if p.f.abs() > self.ef {
+                    m = p;
+                    break;
+                }
+            }
+        }
         if depth >= MAX_DEPTH || m.f.abs() <= self.ef {
-            return None;
+            return self.give_up(a.x, b.x);
         }
         self.interval::<AVX2>(a, m, depth + 1)?;
         self.interval::<AVX2>(m, b, depth + 1)
+    }
+
+    /// F monotone on [a, c] and on [c, b] (c its critical point, within rounding of zero; a and b
+    /// beyond it): the interval around c outside which F is proved beyond rounding, so root-free.
+    /// Found by stepping out from c by the distance at which F's quadratic model leaves the
+    /// rounding band, four times farther each try.
+    #[cold]
+    fn band_around(&self, a: Pt, c: Pt, b: Pt) -> (f64, f64) {
+        let r0 = (4.0 * self.ef / c.s.abs().max(f64::MIN_POSITIVE)).sqrt();
+        let side = |end: Pt, dir: f64| {
+            let mut r = r0;
+            while r < (end.x - c.x).abs() {
+                let p = self.at(c.x + dir * r);
+                if p.f.abs() > self.ef && (p.f < 0.0) == (end.f < 0.0) {
+                    return p.x;
+                }
+                r *= 4.0;
+            }
+            end.x
+        };
+        (side(a, -1.0), side(b, 1.0))
+    }
+
+    /// No test decides [xa, xb]: in certifying mode it is recorded as ambiguous (and the search
+    /// goes on elsewhere); otherwise None, and the caller hands the grid interval to the charts.
+    #[cold]
+    fn give_up(&mut self, xa: f64, xb: f64) -> Option<()> {
+        let amb = self.ambiguous.as_mut()?;
+        let full = amb.is_full();
+        match amb.last_mut() {
+            // Adjacent pieces (a bisection that gave up on both halves) make one interval; with
+            // the list full, the last one grows over the rest.
+            Some(last) if last[1] >= xa || full => last[1] = last[1].max(xb),
+            _ => amb.push([xa, xb]),
+        }
+        Some(())
     }
 
     /// The roots in [xa, xb] (inside [-pi/2, pi/2] or outside it) from the half-angle chart that
@@ -672,6 +782,12 @@ impl Isolation {
 #[target_feature(enable = "avx2")]
 fn roots_sin_cos_avx2(t: &Trig) -> ArrayVec<TrigRoot, MAX_TRIG_ROOTS> {
     t.roots_sin_cos_built::<true>()
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn roots_certified_avx2(t: &Trig, coef_err: f64) -> Isolated {
+    t.isolate_built::<true>(coef_err, true)
 }
 
 #[cfg(target_arch = "x86_64")]
