@@ -7,7 +7,7 @@
 
 use arrayvec::ArrayVec;
 
-use crate::poly::{Root, push_unique, roots_in};
+use crate::poly::{Root, push_unique, roots_in_with_error};
 
 /// The roots on one interval: at most three, plus critical points reported as touching.
 pub type CubicRoots = ArrayVec<Root, 8>;
@@ -16,6 +16,12 @@ pub type CubicRoots = ArrayVec<Root, 8>;
 /// semantics of [`roots_in`] (end points that are roots included, critical points where |p|
 /// is within its rounding error reported as touching).
 pub fn cubic_roots_in(c: &[f64; 4], lo: f64, hi: f64) -> CubicRoots {
+    cubic_roots_in_with_error(c, &[0.0; 4], lo, hi)
+}
+
+/// [`cubic_roots_in`] where coefficient i may be off by `err[i]`: its decisions (a sign change,
+/// a critical point touching zero) hold for the exact cubic.
+pub fn cubic_roots_in_with_error(c: &[f64; 4], err: &[f64; 4], lo: f64, hi: f64) -> CubicRoots {
     let scale = c.iter().fold(0.0f64, |m, a| m.max(a.abs()));
     // p' = 3 c3 x^2 + 2 c2 x + c1: closed form unless it is (nearly) linear or (nearly) a square.
     let (a, b, k) = (3.0 * c[3], 2.0 * c[2], c[1]);
@@ -26,7 +32,10 @@ pub fn cubic_roots_in(c: &[f64; 4], lo: f64, hi: f64) -> CubicRoots {
         || !disc.is_finite()
         || lo.partial_cmp(&hi) != Some(std::cmp::Ordering::Less)
     {
-        return roots_in(c, lo, hi).into_iter().take(8).collect();
+        return roots_in_with_error(c, err, lo, hi)
+            .into_iter()
+            .take(8)
+            .collect();
     }
     let mut crit = ArrayVec::<f64, 2>::new();
     if disc > 0.0 {
@@ -36,7 +45,7 @@ pub fn cubic_roots_in(c: &[f64; 4], lo: f64, hi: f64) -> CubicRoots {
         crit.extend([x1, x2].into_iter().filter(|&x| x > lo && x < hi));
     }
     let mut out = CubicRoots::new();
-    let (mut xa, (mut fa, mut ea)) = (lo, eval_with_error(c, lo));
+    let (mut xa, (mut fa, mut ea)) = (lo, eval_with_error(c, err, lo));
     if fa.abs() <= ea {
         out.push(Root {
             x: lo,
@@ -45,7 +54,7 @@ pub fn cubic_roots_in(c: &[f64; 4], lo: f64, hi: f64) -> CubicRoots {
     }
     for k in 0..=crit.len() {
         let xb = if k < crit.len() { crit[k] } else { hi };
-        let (fb, eb) = eval_with_error(c, xb);
+        let (fb, eb) = eval_with_error(c, err, xb);
         let b_zero = fb.abs() <= eb;
         if fa.abs() > ea && !b_zero && (fa < 0.0) != (fb < 0.0) {
             push_unique(&mut out, bracketed(c, xa, xb, fa, fb));
@@ -63,16 +72,17 @@ pub fn cubic_roots_in(c: &[f64; 4], lo: f64, hi: f64) -> CubicRoots {
     out
 }
 
-/// p(x) and a bound on its rounding error, as [`crate::poly::eval_with_error`] for degree 3.
+/// p(x) and a bound on its error, as [`crate::poly::eval_with_coefficient_error`] for degree 3.
 #[inline]
-fn eval_with_error(c: &[f64; 4], x: f64) -> (f64, f64) {
+fn eval_with_error(c: &[f64; 4], err: &[f64; 4], x: f64) -> (f64, f64) {
     let ax = x.abs();
+    let coef = ((err[3] * ax + err[2]) * ax + err[1]) * ax + err[0];
     let p3 = c[3];
     let p2 = p3 * x + c[2];
     let p1 = p2 * x + c[1];
     let p0 = p1 * x + c[0];
     let bound = ((p3.abs() * ax + p2.abs()) * ax + p1.abs()) * ax + p0.abs();
-    (p0, bound * 16.0 * f64::EPSILON)
+    (p0, bound * 16.0 * f64::EPSILON + coef)
 }
 
 /// The root of a cubic that is monotone on [a, b] with p(a), p(b) of opposite signs: Halley
@@ -171,6 +181,7 @@ pub fn deflated_roots_in(c: &[f64; 4], w: f64, lo: f64, hi: f64) -> Option<Array
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::poly::roots_in;
     use crate::test_rng::lcg;
 
     fn from_roots(rs: [f64; 3], lead: f64) -> [f64; 4] {
@@ -202,7 +213,7 @@ mod tests {
                 assert!((f.x - g.x).abs() < 1e-9, "{rs:?}: {fast:?} vs {slow:?}");
                 assert_eq!(f.touching, g.touching, "{rs:?}: {fast:?} vs {slow:?}");
                 // As exact as the cubic allows: p there within twice its rounding error.
-                let (p, err) = eval_with_error(&c, f.x);
+                let (p, err) = eval_with_error(&c, &[0.0; 4], f.x);
                 assert!(p.abs() <= 2.0 * err, "{rs:?}: p({}) = {p:e} > {err:e}", f.x);
             }
         }

@@ -14,6 +14,7 @@
 use nalgebra::Vector3;
 
 use crate::machine::Machine;
+use crate::module_fk::FkMode;
 use crate::module_geometry::Sliders;
 use crate::module_ik::{self, IkBranch, wrap_angle};
 
@@ -39,10 +40,13 @@ pub enum HardSet {
     /// det A = 0 (A the Jacobian of (3)-(6) in the pose): a parallel singularity, where two
     /// assembly modes meet and F has a double root; next to it, two close simple roots.
     ParallelSingularity,
+    /// The cubic (9) in cos(alpha) has a double root at the branch's cos(alpha) (its derivative
+    /// vanishes there): two leg-I postures of the point meet.
+    Cubic9DoubleRoot,
 }
 
 impl HardSet {
-    pub const ALL: [HardSet; 8] = [
+    pub const ALL: [HardSet; 9] = [
         HardSet::Condition21,
         HardSet::SliderMean,
         HardSet::Condition20,
@@ -51,6 +55,7 @@ impl HardSet {
         HardSet::AlphaPi,
         HardSet::StretchedLeg2,
         HardSet::ParallelSingularity,
+        HardSet::Cubic9DoubleRoot,
     ];
 
     pub fn name(self) -> &'static str {
@@ -63,6 +68,7 @@ impl HardSet {
             HardSet::AlphaPi => "alpha_pi",
             HardSet::StretchedLeg2 => "stretched_leg2",
             HardSet::ParallelSingularity => "parallel_singularity",
+            HardSet::Cubic9DoubleRoot => "cubic9_double_root",
         }
     }
 
@@ -98,6 +104,10 @@ impl HardSet {
                     alpha: b.alpha,
                 };
                 crate::module_geometry::jacobian_pose(g, &pose, &b.rho).determinant()
+            }
+            HardSet::Cubic9DoubleRoot => {
+                let k = module_ik::eq9_coefficients(g, p);
+                (3.0 * k[3] * c + 2.0 * k[2]) * c + k[1]
             }
         }
     }
@@ -212,6 +222,122 @@ pub fn construct(
             })
         })
         .collect()
+}
+
+/// The branch of the inverse kinematics that a forward-kinematics mode is.
+fn as_branch(mode: &FkMode, rho: &Sliders) -> IkBranch {
+    IkBranch {
+        alpha: mode.pose.alpha,
+        rho: *rho,
+        config: mode.config,
+        verdict: mode.verdict,
+    }
+}
+
+/// The mode of `rho` nearest `prev` (pose and alpha), if `rho` has any.
+fn follow_mode(m: &Machine, rho: &Sliders, prev: &FkMode) -> Option<FkMode> {
+    let d = |a: &FkMode| {
+        1000.0 * wrap_angle(a.pose.alpha - prev.pose.alpha).abs() + (a.pose.p - prev.pose.p).amax()
+    };
+    crate::module_fk::solve(m, rho)
+        .into_iter()
+        .min_by(|a, b| d(a).total_cmp(&d(b)))
+}
+
+/// [`construct`] from the other side: the sliders move along `rho0 + s dir` and an assembly
+/// mode is followed (for the inverse kinematics' tests: its branches at the mode's point must
+/// contain the sliders). The quantity is that of [`HardSet::quantity`] at the mode.
+pub fn construct_from_sliders(
+    m: &Machine,
+    set: HardSet,
+    rho0: &Sliders,
+    dir: &Vector3<f64>,
+    mode: &FkMode,
+    reach: f64,
+) -> Vec<Constructed> {
+    let dir = dir.normalize();
+    let at = |s: f64| rho0 + dir * s;
+    let q_of = |rho: &Sliders, md: &FkMode| set.quantity(m, &md.pose.p, &as_branch(md, rho));
+    let dist = |a: &FkMode, b: &FkMode| {
+        1000.0 * wrap_angle(a.pose.alpha - b.pose.alpha).abs() + (a.pose.p - b.pose.p).amax()
+    };
+    let step = reach / SCAN_STEPS as f64;
+    let mut bracket = None;
+    'sides: for side in [1.0, -1.0] {
+        let mut prev = *mode;
+        let mut q_prev = q_of(rho0, &prev);
+        for k in 1..=SCAN_STEPS {
+            let s = side * step * k as f64;
+            let rho = at(s);
+            let Some(md) = follow_mode(m, &rho, &prev) else {
+                continue 'sides;
+            };
+            if dist(&md, &prev) > 50.0 * step.max(1.0) {
+                continue 'sides;
+            }
+            let q = q_of(&rho, &md);
+            if q.is_finite() && q_prev.is_finite() && (q < 0.0) != (q_prev < 0.0) {
+                bracket = Some((s - side * step, prev, s, md));
+                break 'sides;
+            }
+            prev = md;
+            q_prev = q;
+        }
+    }
+    let Some((mut sa, mut ma, mut sb, mut mb)) = bracket else {
+        return Vec::new();
+    };
+    let neg_a = q_of(&at(sa), &ma) < 0.0;
+    for _ in 0..200 {
+        let sm = 0.5 * (sa + sb);
+        if sm == sa || sm == sb {
+            break;
+        }
+        let rho = at(sm);
+        let Some(mm) = follow_mode(m, &rho, &ma) else {
+            return Vec::new();
+        };
+        let q = q_of(&rho, &mm);
+        if !q.is_finite() {
+            return Vec::new();
+        }
+        if (q < 0.0) == neg_a {
+            (sa, ma) = (sm, mm);
+        } else {
+            (sb, mb) = (sm, mm);
+        }
+    }
+    let near = if (sb - sa).abs() < 1.0 { ma } else { mb };
+    OFFSETS_MM
+        .iter()
+        .filter_map(|&off| {
+            let rho = at(sa + off);
+            let md = follow_mode(m, &rho, &near)?;
+            Some(Constructed {
+                set,
+                offset_mm: off,
+                p: md.pose.p,
+                alpha: md.pose.alpha,
+                rho,
+            })
+        })
+        .collect()
+}
+
+/// A start for [`construct_from_sliders`]: random sliders within the strokes with one of their
+/// assembly modes.
+pub fn random_slider_start(m: &Machine, rng: &mut Sampler) -> Option<(Sliders, FkMode)> {
+    let l = &m.limits;
+    for _ in 0..50 {
+        let rho = Sliders::from_fn(|j, _| rng.uniform(l.rho_min[j], l.rho_max[j]));
+        let modes = crate::module_fk::solve(m, &rho);
+        if modes.is_empty() {
+            continue;
+        }
+        let mode = modes[(rng.next_u64() % modes.len() as u64) as usize];
+        return Some((rho, mode));
+    }
+    None
 }
 
 /// A small deterministic generator (xorshift64*), for sampling starts reproducibly.

@@ -83,6 +83,17 @@ impl Iv {
         self.lo.abs().max(self.hi.abs())
     }
 
+    /// |x| over the interval.
+    pub fn abs(self) -> Iv {
+        if self.lo >= 0.0 {
+            self
+        } else if self.hi <= 0.0 {
+            -self
+        } else {
+            Iv::new(0.0, self.mag())
+        }
+    }
+
     /// The midpoint (rounded).
     pub fn mid(self) -> f64 {
         0.5 * (self.lo + self.hi)

@@ -5,6 +5,8 @@
 pub mod apt;
 pub mod arg_values;
 pub mod branches;
+pub mod certificate;
+pub(crate) mod certify;
 pub mod cpu;
 pub mod cubic;
 pub mod dd;
@@ -17,8 +19,10 @@ pub mod glider;
 pub mod hard_sets;
 pub mod interval;
 pub mod jacobian;
+pub(crate) mod leg1_certify;
 pub mod machine;
 pub mod machine_kin;
+
 pub mod machine_rows;
 pub mod module_fk;
 pub mod module_geometry;

@@ -34,6 +34,8 @@ use arrayvec::ArrayVec;
 use nalgebra::{Matrix2, Matrix4, Vector2, Vector3, Vector4};
 
 use crate::branches::{Config, Reason, Verdict, cos_tilt_max, leg_state, listed_in_order};
+use crate::certificate::{Certificate, Certified};
+use crate::leg1_certify;
 use crate::machine::{Machine, TableGeometry};
 use crate::module_geometry::{ModulePose, Sliders, residual_mm_sc};
 use crate::module_ik::{Leg1, posture_branches, wrap_angle};
@@ -44,7 +46,7 @@ use crate::tolerance::{
     ACCEPT_RESIDUAL_MM, LIMIT_SLACK, NEWTON_MAX_ITER, NEWTON_STEP_STOP, SAME_SOLUTION_MM,
     SAME_SOLUTION_RAD,
 };
-use crate::trig::{Trig, TrigRoot, sin_cos_after_step};
+use crate::trig::{Trig, sin_cos_after_step};
 
 /// |sin(alpha)| (dimensionless) below which both signs of rho1 - zp are tried at a root of F:
 /// there F has a double root or two very close ones and the sign from eq. (14) is unreliable.
@@ -109,8 +111,13 @@ impl MachineIkBranch {
     }
 }
 
-/// Every machine inverse-kinematics branch of one tool pose.
-pub type MachineIkBranches = ArrayVec<MachineIkBranch, MAX_MACHINE_IK_BRANCHES>;
+/// Every machine inverse-kinematics branch of one tool pose, with the certificate that says why
+/// there are no others.
+pub type MachineIkBranches = Certified<MachineIkBranch, MAX_MACHINE_IK_BRANCHES>;
+
+/// How far (rad) the Newton polish may move theta1 from a proved root: the root is accurate to
+/// rounding, so a posture farther than this is some other root's.
+const ROOT_POLISH_RAD: f64 = 1e-6;
 
 /// One assembly mode of the machine's forward kinematics.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -353,7 +360,8 @@ pub fn machine_ik_into(
     tool_length: f64,
     out: &mut MachineIkBranches,
 ) {
-    out.clear();
+    out.reset();
+    let mut certificate = Certificate::Double;
     let finite = pose.tip.iter().all(|v| v.is_finite())
         && pose.phi1.is_finite()
         && pose.phi2.is_finite()
@@ -371,66 +379,113 @@ pub fn machine_ik_into(
         cos_phi1,
     };
     let f = theta1_equation(m, pose, tool_length);
-    // Seeds: the roots of F on the circle, plus the two values where sin(alpha) = 0 when F is
-    // near zero there: its double roots (flagged: both signs of rho1 - zp there, Table II of
-    // IFToMM 2007). At sin(alpha) = 0, F = yp^2 (R1 -/+ r1)^2 >= 0, a double root iff yp = 0;
-    // where F is clearly positive there, the roots nearby are simple and isolated (and with
-    // sin(alpha) that small both signs are tried anyway). Elsewhere the sign comes from eq. (14),
-    // even at a double root of F (a tangency, where it is still defined).
-    let roots = f.roots_sin_cos();
+    let iso = f.roots_certified(leg1_certify::equation_error(m, &path.w, sin_phi1, cos_phi1));
+    // One leg-I posture (theta1, rho1) per proved root of F: F = h+ h- (leg1_certify), a
+    // simple root belongs to one factor, whose sign of rho1 - zp is that of eq. (14), IFToMM
+    // 2007, or where sin(alpha) is too small to tell, the factor's own.
+    let mut proved: ArrayVec<(f64, f64), 12> = ArrayVec::new();
+    let mut forms = None;
+    for root in &iso.roots {
+        let seed = PathPoint {
+            theta1: root.x,
+            sin: root.sin,
+            cos: root.cos,
+            rho1: 0.0,
+        };
+        let (p, _) = platform_at(m.table.d_a, &path.w, root.sin, root.cos);
+        let (sa, ca) = path.alpha_sin_cos(&seed);
+        let rho1 = if sa.abs() >= BOTH_SIGNS_SIN_ALPHA {
+            Some(p.z + p.y * (r * ca - rr) / (r * sa))
+        } else {
+            let f64_forms = forms.get_or_insert_with(|| {
+                leg1_certify::path_forms::<f64>(m, &path.w, sin_phi1, cos_phi1)
+            });
+            leg1_certify::posture_rho1(f64_forms, root.x)
+        };
+        match rho1 {
+            Some(rho1) => {
+                let _ = proved.try_push((root.x, rho1));
+            }
+            None => certificate = Certificate::Unproved,
+        }
+    }
+    // Other seeds, which the proof does not predict: near the roots' two values where
+    // sin(alpha) = 0 when F is small there (its double roots, both signs of rho1 - zp, Table II
+    // of IFToMM 2007). A posture they find that no proved root gave makes the result unproved.
+    let mut others: ArrayVec<(f64, f64), 12> = ArrayVec::new();
+    let mut allowed: ArrayVec<(f64, f64), 12> = ArrayVec::new();
+    if !iso.ambiguous.is_empty() {
+        let resolution = leg1_certify::resolve(
+            m,
+            &path.w,
+            (sin_phi1, cos_phi1),
+            &iso.ambiguous,
+            &mut proved,
+            &mut allowed,
+            &mut others,
+        );
+        certificate = certificate.max(Certificate::from(resolution));
+    }
     let f_scale = f
         .cos
         .iter()
         .chain(&f.sin)
         .fold(0.0f64, |m, a| m.max(a.abs()));
-    let mut alpha_zero_seeds = ArrayVec::<TrigRoot, 2>::new();
     for th in [-pose.phi1, PI - pose.phi1] {
         let (sin, cos) = th.sin_cos();
         if f.eval_sc(sin, cos) <= ALPHA_ZERO_SEED_REL * f_scale {
-            alpha_zero_seeds.push(TrigRoot { x: th, sin, cos });
+            let (p, _) = platform_at(m.table.d_a, &path.w, sin, cos);
+            let (sa, ca) = path.alpha_sin_cos(&PathPoint {
+                theta1: th,
+                sin,
+                cos,
+                rho1: 0.0,
+            });
+            let u = p.x + g.dx1;
+            let k1 = g.l1 * g.l1 - r * r - rr * rr + 2.0 * r * rr * ca;
+            let h = (k1 - u * u - p.y * p.y).max(0.0).sqrt();
+            let _ = sa;
+            for rho1 in [p.z + h, p.z - h] {
+                let _ = others.try_push((th, rho1));
+            }
         }
     }
-    let seeds = roots
-        .iter()
-        .map(|root| (*root, false))
-        .chain(alpha_zero_seeds.iter().map(|root| (*root, true)));
+    let n_proved = proved.len();
+    let n_expected = n_proved + allowed.len();
     let mut pairs: ArrayVec<PathPoint, MAX_THETA1_SOLUTIONS> = ArrayVec::new();
-    for (root, at_alpha_zero) in seeds {
-        let seed = |rho1: f64| PathPoint {
-            theta1: root.x,
-            sin: root.sin,
-            cos: root.cos,
+    for (k, &(theta1, rho1)) in proved.iter().chain(&allowed).chain(&others).enumerate() {
+        let (sin, cos) = theta1.sin_cos();
+        let (q, fv) = path.polish(PathPoint {
+            theta1,
+            sin,
+            cos,
             rho1,
-        };
-        let (p, _) = platform_at(m.table.d_a, &path.w, root.sin, root.cos);
-        let (sa, ca) = path.alpha_sin_cos(&seed(0.0));
-        let u = p.x + g.dx1;
-        let k1 = g.l1 * g.l1 - r * r - rr * rr + 2.0 * r * rr * ca;
-        let h2 = k1 - u * u - p.y * p.y;
-        let h = h2.max(0.0).sqrt();
-        let mut starts: ArrayVec<f64, 2> = ArrayVec::new();
-        if at_alpha_zero || sa.abs() < BOTH_SIGNS_SIN_ALPHA {
-            starts.push(p.z + h);
-            starts.push(p.z - h);
-        } else {
-            // rho1 - zp from eq. (14), IFToMM 2007.
-            starts.push(p.z + p.y * (r * ca - rr) / (r * sa));
+        });
+        // Residuals of (10) and (14) as lengths along the rod (mm).
+        let res = (fv.x / (2.0 * g.l1)).abs().max((fv.y / r).abs());
+        if res.is_nan() || res > ACCEPT_RESIDUAL_MM {
+            if k < n_proved {
+                certificate = Certificate::Unproved;
+            }
+            continue;
         }
-        for rho1 in starts {
-            let (q, fv) = path.polish(seed(rho1));
-            // Residuals of (10) and (14) as lengths along the rod (mm).
-            let res = (fv.x / (2.0 * g.l1)).abs().max((fv.y / r).abs());
-            if res.is_nan() || res > ACCEPT_RESIDUAL_MM {
+        if k < n_proved && wrap_angle(q.theta1 - theta1).abs() > ROOT_POLISH_RAD {
+            certificate = Certificate::Unproved;
+        }
+        let dup = pairs.iter().any(|o| {
+            wrap_angle(o.theta1 - q.theta1).abs() < SAME_SOLUTION_RAD
+                && (o.rho1 - q.rho1).abs() < SAME_SOLUTION_MM * (1.0 + q.rho1.abs())
+        });
+        if dup {
+            continue;
+        }
+        if k >= n_expected || pairs.is_full() {
+            certificate = Certificate::Unproved;
+            if pairs.is_full() {
                 continue;
             }
-            let dup = pairs.iter().any(|o| {
-                wrap_angle(o.theta1 - q.theta1).abs() < SAME_SOLUTION_RAD
-                    && (o.rho1 - q.rho1).abs() < SAME_SOLUTION_MM * (1.0 + q.rho1.abs())
-            });
-            if !dup && !pairs.is_full() {
-                pairs.push(q);
-            }
         }
+        pairs.push(q);
     }
     let theta2 = wrap_angle(-pose.phi2);
     let cos_tilt = cos_tilt_max(m);
@@ -473,6 +528,7 @@ pub fn machine_ik_into(
             }
         }
     }
+    out.certificate = certificate;
     // Usually in order already (roots by increasing theta1, a posture's four branches by
     // (s2, s3)): sorted only when that check fails.
     let in_order = out

@@ -29,8 +29,10 @@ use arrayvec::ArrayVec;
 use nalgebra::{Matrix3, Vector3};
 
 use crate::branches::{Config, Verdict, label};
+pub use crate::certificate::Certificate;
+use crate::certificate::Certified;
 use crate::cpu;
-use crate::fk_certify::{self, ProvedStart, Resolution};
+use crate::fk_certify::{self, ProvedStart};
 use crate::machine::{Machine, ModuleGeometry};
 use crate::module_geometry::{ModulePose, Sliders, polish_pose_from, residual_mm};
 use crate::module_ik::wrap_angle;
@@ -48,42 +50,6 @@ const ROOT_POLISH_RAD: f64 = 1e-6;
 /// Most assembly modes returned (the degree-8 polynomial, plus degenerate doubled solutions).
 pub const MAX_FK_MODES: usize = 16;
 
-/// What proves that the assembly modes returned are all the real ones (module documentation).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Default, Hash)]
-pub enum Certificate {
-    /// Every real root of F isolated in double precision, each proved simple, with a bound on
-    /// the rounding of F's coefficients and of its evaluation; every other angle proved not a
-    /// root; each root gave its mode.
-    #[default]
-    Double,
-    /// As [`Certificate::Double`], except on intervals next to a zero of condition (21), where
-    /// two modes share nearly the same alpha: there the roots of the two factors of F were
-    /// proved by interval arithmetic ([`crate::fk_certify`]).
-    Factored,
-    /// Some interval needed the degree-8 polynomial in double-double precision.
-    Extended,
-    /// Some interval of alpha could be decided by none of the methods: the modes returned are
-    /// what was found, not proved complete (status `uncertified`).
-    Unproved,
-}
-
-impl Certificate {
-    /// True unless [`Certificate::Unproved`].
-    pub fn proved(self) -> bool {
-        self != Certificate::Unproved
-    }
-
-    /// Its name in reports: `double`, `factored`, `extended`, `unproved`.
-    pub fn code(self) -> &'static str {
-        match self {
-            Certificate::Double => "double",
-            Certificate::Factored => "factored",
-            Certificate::Extended => "extended",
-            Certificate::Unproved => "unproved",
-        }
-    }
-}
-
 /// One assembly mode.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FkMode {
@@ -100,47 +66,7 @@ impl FkMode {
 
 /// Every real assembly mode of one set of slider positions, with the certificate that says why
 /// there are no others. Dereferences to the list of modes.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct FkModes {
-    modes: ArrayVec<FkMode, MAX_FK_MODES>,
-    /// How completeness was proved, or that it was not.
-    pub certificate: Certificate,
-}
-
-impl FkModes {
-    pub fn new() -> FkModes {
-        FkModes::default()
-    }
-}
-
-impl std::ops::Deref for FkModes {
-    type Target = ArrayVec<FkMode, MAX_FK_MODES>;
-    fn deref(&self) -> &Self::Target {
-        &self.modes
-    }
-}
-
-impl std::ops::DerefMut for FkModes {
-    fn deref_mut(&mut self) -> &mut Self::Target {
-        &mut self.modes
-    }
-}
-
-impl IntoIterator for FkModes {
-    type Item = FkMode;
-    type IntoIter = arrayvec::IntoIter<FkMode, MAX_FK_MODES>;
-    fn into_iter(self) -> Self::IntoIter {
-        self.modes.into_iter()
-    }
-}
-
-impl<'a> IntoIterator for &'a FkModes {
-    type Item = &'a FkMode;
-    type IntoIter = std::slice::Iter<'a, FkMode>;
-    fn into_iter(self) -> Self::IntoIter {
-        self.modes.iter()
-    }
-}
+pub type FkModes = Certified<FkMode, MAX_FK_MODES>;
 
 /// The linear trigonometric forms of the elimination for one set of slider positions.
 struct Elimination {
@@ -385,13 +311,19 @@ fn solve_built<const AVX2: bool>(m: &Machine, rho: &Sliders) -> FkModes {
     // Other starts: what the proof does not predict (any mode they find that the proved roots
     // did not is a contradiction, and the result is then unproved).
     let mut others: ArrayVec<ProvedStart, 40> = ArrayVec::new();
+    // Starts of intervals too narrow for double-double that hold at most one mode each: a mode
+    // they find is expected, none is too.
+    let mut allowed: ArrayVec<ProvedStart, 40> = ArrayVec::new();
     if !iso.ambiguous.is_empty() {
-        let resolution = fk_certify::resolve(g, rho, &iso.ambiguous, &mut proved, &mut others);
-        out.certificate = out.certificate.max(match resolution {
-            Resolution::Factored => Certificate::Factored,
-            Resolution::Extended => Certificate::Extended,
-            Resolution::Unproved => Certificate::Unproved,
-        });
+        let resolution = fk_certify::resolve(
+            g,
+            rho,
+            &iso.ambiguous,
+            &mut proved,
+            &mut allowed,
+            &mut others,
+        );
+        out.weaken(Certificate::from(resolution));
     }
     // Where condition (21) fails (Det = 0), a real solution forces b = 0 there and F then has
     // (at least) a double root, F = 4 b^2 (Q^2 + delta^2 (R1^2 + r1^2 - 2 R1 r1 c)) >= 0 (it
@@ -412,7 +344,8 @@ fn solve_built<const AVX2: bool>(m: &Machine, rho: &Sliders) -> FkModes {
         }
     }
     let n_proved = proved.len();
-    for (k, start) in proved.iter().chain(&others).enumerate() {
+    let n_expected = n_proved + allowed.len();
+    for (k, start) in proved.iter().chain(&allowed).chain(&others).enumerate() {
         let (pose, residual, (s, c)) = polish_pose_from(g, start.pose, start.sc, rho);
         if residual > ACCEPT_RESIDUAL_MM {
             if k < n_proved {
@@ -436,7 +369,7 @@ fn solve_built<const AVX2: bool>(m: &Machine, rho: &Sliders) -> FkModes {
         if dup {
             continue;
         }
-        if k >= n_proved || out.is_full() {
+        if k >= n_expected || out.is_full() {
             // A mode no proved root predicted (or more than the list holds).
             out.certificate = Certificate::Unproved;
             if out.is_full() {

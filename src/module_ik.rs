@@ -17,12 +17,16 @@ use crate::branches::{
     Config, Verdict, WORKING_CONFIG, cos_tilt_max, leg_state, listed_in_order, outer_leg_labels,
     outer_leg_states, rods_cross, stroke_verdict,
 };
+use crate::certificate::{Certificate, Certified};
 use crate::cpu;
-use crate::cubic::{cubic_roots_in, deflated_roots_in};
+use crate::cubic::{cubic_roots_in, cubic_roots_in_with_error, deflated_roots_in};
+use crate::dd::Tracked;
 use crate::machine::{Machine, ModuleGeometry};
 use crate::module_geometry::Sliders;
 #[cfg(target_arch = "x86_64")]
 use crate::module_ik_x4;
+use crate::scalar::Mag;
+use crate::tolerance::ACCEPT_RESIDUAL_MM;
 use crate::tolerance::{
     NEWTON_MAX_ITER, NEWTON_STEP_STOP, SAME_SOLUTION_RAD, SIN_ALPHA_ZERO, SQRT_ARG_REL,
 };
@@ -46,7 +50,9 @@ impl IkBranch {
     }
 }
 
-pub type IkBranches = ArrayVec<IkBranch, MAX_IK_BRANCHES>;
+/// Every inverse-kinematics branch of one point, with the certificate that says why there are
+/// no others.
+pub type IkBranches = Certified<IkBranch, MAX_IK_BRANCHES>;
 
 /// A leg-I posture: an orientation alpha and the slider-1 position that goes with it.
 #[derive(Debug, Clone, Copy)]
@@ -70,7 +76,7 @@ pub fn cubic_eq9(g: &ModuleGeometry, p: &Vector3<f64>) -> Option<[f64; 4]> {
 
 /// The coefficients of eq. (9), lowest degree first, as they come (not normalised).
 #[inline]
-pub(crate) fn eq9_coefficients(g: &ModuleGeometry, p: &Vector3<f64>) -> [f64; 4] {
+pub fn eq9_coefficients(g: &ModuleGeometry, p: &Vector3<f64>) -> [f64; 4] {
     let (r, rr) = (g.r_big1, g.r_small1);
     let u = p.x + g.dx1;
     let y = p.y;
@@ -81,6 +87,27 @@ pub(crate) fn eq9_coefficients(g: &ModuleGeometry, p: &Vector3<f64>) -> [f64; 4]
     let p3 = -2.0 * r * r * r * rr - 2.0 * r * rr * y * y;
     let p4 = r * r * u * u + (r * r + rr * rr) * y * y - r * r * k0;
     [p4, p3, p2, p1]
+}
+
+/// Rounded operations on any path from an input to a coefficient of eq. (9) (about 8): a
+/// generous count.
+const EQ9_OPS: f64 = 16.0;
+
+/// Bounds on the errors of [`eq9_coefficients`] (lowest degree first), from the magnitudes of
+/// their formulas ([`Mag`]).
+fn eq9_errors(g: &ModuleGeometry, p: &Vector3<f64>) -> [f64; 4] {
+    let (r, rr) = (Mag::from(g.r_big1), Mag::from(g.r_small1));
+    let u = Mag::from(p.x) + Mag::from(g.dx1);
+    let y = Mag::from(p.y);
+    let two = Mag::from(2.0);
+    let k0 = Mag::from(g.l1) * Mag::from(g.l1) + r * r + rr * rr;
+    let mags = [
+        r * r * u * u + (r * r + rr * rr) * y * y + r * r * k0,
+        two * r * r * r * rr + two * r * rr * y * y,
+        r * r * k0 + r * r * u * u,
+        two * r * r * r * rr,
+    ];
+    mags.map(|m| EQ9_OPS * f64::EPSILON * m.0)
 }
 
 /// |rho1 - zp| from eq. (11) at cos(alpha) = c, squared (negative when leg I cannot reach).
@@ -94,15 +121,27 @@ fn leg1_height_sq(g: &ModuleGeometry, p: &Vector3<f64>, c: f64) -> f64 {
 /// The roots of eq. (9) in cos(alpha) other than the certified one (`certified`: the point's
 /// [`certified_lanes`] posture, when it has one), in increasing order: all of them without it.
 /// With it, the others are all below r1/R1: from the cubic divided by the known root (no
-/// isolation), unless that is a close call. Empty when the cubic is degenerate.
+/// isolation), unless that is a close call. Empty when the cubic is degenerate. A root where
+/// the cubic touches zero within its error (two roots too close to separate, a double root, or
+/// none) comes as `touching`: [`leg1_postures_into`] decides it.
 #[inline(always)]
-fn other_roots(g: &ModuleGeometry, p: &Vector3<f64>, certified: Option<Leg1>) -> ArrayVec<f64, 8> {
-    let all_roots = |lo: f64, hi: f64| match cubic_eq9(g, p) {
-        Some(coeffs) => cubic_roots_in(&coeffs, lo, hi)
-            .iter()
-            .map(|t| t.x)
-            .collect(),
-        None => ArrayVec::new(),
+fn other_roots(g: &ModuleGeometry, p: &Vector3<f64>, certified: Option<Leg1>) -> OtherRoots {
+    let all_roots = |lo: f64, hi: f64| {
+        let mut out = OtherRoots::default();
+        let c = eq9_coefficients(g, p);
+        let scale = c.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+        if scale == 0.0 || !scale.is_finite() {
+            return out;
+        }
+        let err = eq9_errors(g, p).map(|e| e / scale);
+        for r in cubic_roots_in_with_error(&c.map(|a| a / scale), &err, lo, hi) {
+            if r.touching {
+                let _ = out.touching.try_push(r.x);
+            } else {
+                let _ = out.roots.try_push(r.x);
+            }
+        }
+        out
     };
     match certified {
         // The certificate saw finite coefficients with c3 > 0, and the division's thresholds
@@ -110,12 +149,24 @@ fn other_roots(g: &ModuleGeometry, p: &Vector3<f64>, certified: Option<Leg1>) ->
         Some(leg1) => {
             let hi = g.r_small1 / g.r_big1 - FAST_MARGIN_RAD;
             match deflated_roots_in(&eq9_coefficients(g, p), leg1.cos, -1.0, hi) {
-                Some(roots) => roots,
+                Some(roots) => OtherRoots {
+                    roots,
+                    touching: ArrayVec::new(),
+                },
                 None => all_roots(-1.0, hi),
             }
         }
         None => all_roots(-1.0, 1.0),
     }
+}
+
+/// The roots of (9) from [`other_roots`].
+#[derive(Debug, Clone, Default)]
+pub(crate) struct OtherRoots {
+    /// Proved simple roots, in increasing order.
+    pub roots: ArrayVec<f64, 8>,
+    /// Critical points where the cubic touches zero within its error.
+    pub touching: ArrayVec<f64, 4>,
 }
 
 /// Every real leg-I posture (alpha, rho1) for the point into `out`: those of `roots` (from
@@ -127,11 +178,11 @@ fn other_roots(g: &ModuleGeometry, p: &Vector3<f64>, certified: Option<Leg1>) ->
 fn leg1_postures_into(
     g: &ModuleGeometry,
     p: &Vector3<f64>,
-    roots: &[f64],
+    roots: &OtherRoots,
     certified: Option<Leg1>,
     out: &mut ArrayVec<Leg1, 6>,
-) {
-    let (r, rr) = (g.r_big1, g.r_small1);
+) -> Certificate {
+    let mut certificate = Certificate::Double;
     out.clear();
     let mut push = |l: Leg1| {
         let dup = out.iter().any(|o: &Leg1| {
@@ -141,54 +192,176 @@ fn leg1_postures_into(
             out.push(l);
         }
     };
-    for &root in roots {
-        let c = root.clamp(-1.0, 1.0);
-        let sin_a = ((1.0 - c) * (1.0 + c)).sqrt();
-        let h2 = leg1_height_sq(g, p, c);
-        let h = if h2 >= -SQRT_ARG_REL * g.l1 * g.l1 {
-            h2.max(0.0).sqrt()
-        } else {
-            continue;
-        };
-        if sin_a < SIN_ALPHA_ZERO {
-            // alpha in {0, pi}: eq. (14) is 0 = 0, both signs of eq. (11) (Table II).
-            let a0 = if c > 0.0 { 0.0 } else { std::f64::consts::PI };
-            let (sin, cos) = a0.sin_cos();
-            for rho1 in [p.z + h, p.z - h] {
-                push(polish_leg1(
-                    g,
-                    p,
-                    Leg1 {
-                        alpha: a0,
-                        rho1,
-                        sin,
-                        cos,
-                    },
-                ));
-            }
-            continue;
-        }
-        // sgn(rho1 - zp) from eq. (14): y (R1 cos a - r1) = R1 sin a (rho1 - zp), R1 sin a > 0.
-        let q = p.y * (r * c - rr);
-        let rho1 = if q == 0.0 { p.z } else { p.z + q.signum() * h };
-        let polished = polish_leg1(
-            g,
-            p,
-            Leg1 {
-                alpha: libm::acos(c),
-                rho1,
-                sin: sin_a,
-                cos: c,
-            },
-        );
-        push(polished);
-        push(mirror(p, polished));
+    if !roots.touching.is_empty() {
+        certificate = touching_postures(g, p, &roots.touching, &mut push);
+    }
+    for &root in &roots.roots {
+        postures_at_root(g, p, root, &mut push);
     }
     // Last, as the root with the largest cos(alpha) (postures come out by increasing cos).
     if let Some(leg1) = certified {
         push(leg1);
         push(mirror(p, leg1));
     }
+    certificate
+}
+
+/// The leg-I postures at a root c = cos(alpha) of (9): alpha = acos(c) with rho1 from eqs. (11)
+/// and (14), polished, and its mirror image; where sin(alpha) = 0 both signs of eq. (11)
+/// (Table II). None where leg I cannot reach.
+fn postures_at_root(g: &ModuleGeometry, p: &Vector3<f64>, root: f64, push: &mut impl FnMut(Leg1)) {
+    let (r, rr) = (g.r_big1, g.r_small1);
+    let c = root.clamp(-1.0, 1.0);
+    let sin_a = ((1.0 - c) * (1.0 + c)).sqrt();
+    let h2 = leg1_height_sq(g, p, c);
+    let h = if h2 >= -SQRT_ARG_REL * g.l1 * g.l1 {
+        h2.max(0.0).sqrt()
+    } else {
+        return;
+    };
+    if sin_a < SIN_ALPHA_ZERO {
+        // alpha in {0, pi}: eq. (14) is 0 = 0, both signs of eq. (11) (Table II).
+        let a0 = if c > 0.0 { 0.0 } else { std::f64::consts::PI };
+        let (sin, cos) = a0.sin_cos();
+        for rho1 in [p.z + h, p.z - h] {
+            push(polish_leg1(
+                g,
+                p,
+                Leg1 {
+                    alpha: a0,
+                    rho1,
+                    sin,
+                    cos,
+                },
+            ));
+        }
+        return;
+    }
+    // sgn(rho1 - zp) from eq. (14): y (R1 cos a - r1) = R1 sin a (rho1 - zp), R1 sin a > 0.
+    let q = p.y * (r * c - rr);
+    let rho1 = if q == 0.0 { p.z } else { p.z + q.signum() * h };
+    let polished = polish_leg1(
+        g,
+        p,
+        Leg1 {
+            alpha: libm::acos(c),
+            rho1,
+            sin: sin_a,
+            cos: c,
+        },
+    );
+    push(polished);
+    push(mirror(p, polished));
+}
+
+/// The coefficients of eq. (9) (lowest degree first) in double-double from the exact inputs.
+fn eq9_tracked(g: &ModuleGeometry, p: &Vector3<f64>) -> [Tracked; 4] {
+    let t = Tracked::exact;
+    let (r, rr) = (t(g.r_big1), t(g.r_small1));
+    let u = t(p.x) + t(g.dx1);
+    let y = t(p.y);
+    let two = t(2.0);
+    let k0 = t(g.l1) * t(g.l1) - r * r - rr * rr;
+    [
+        r * r * u * u + (r * r + rr * rr) * y * y - r * r * k0,
+        -(two * r * r * r * rr) - two * r * rr * y * y,
+        r * r * k0 - r * r * u * u,
+        two * r * r * r * rr,
+    ]
+}
+
+/// The residual of leg I's equations (10) and (14) at a posture, as a length (mm).
+fn leg1_residual_mm(g: &ModuleGeometry, p: &Vector3<f64>, l: &Leg1) -> f64 {
+    let (f, _) = Leg1Equations::new(g, p).residuals(l);
+    (f[0] / (2.0 * g.l1)).abs().max((f[1] / g.r_big1).abs())
+}
+
+/// The postures at roots where the cubic (9) touches zero within its error: on the interval of
+/// alpha where it can be that close to zero, the two factors of leg I's equation
+/// ([`crate::leg1_certify`]) prove each posture (or that there is none); where they cannot,
+/// the touching point is taken as a root, as the cubic's routine gives it, and the result is
+/// unproved.
+#[cold]
+#[inline(never)]
+fn touching_postures(
+    g: &ModuleGeometry,
+    p: &Vector3<f64>,
+    touching: &[f64],
+    push: &mut impl FnMut(Leg1),
+) -> Certificate {
+    let mut certificate = Certificate::Factored;
+    let c = eq9_coefficients(g, p);
+    let scale = c.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+    let err = eq9_errors(g, p).iter().sum::<f64>() / scale;
+    let c = c.map(|a| a / scale);
+    for &ct in touching {
+        // Near the critical point ct the cubic is about its second derivative times
+        // (x - ct)^2 / 2: it can come within its error of zero only for |x - ct| below about
+        // sqrt(2 err / |p2|); four times that, plus rounding, is searched.
+        let p2 = (6.0 * c[3] * ct + 2.0 * c[2]).abs();
+        let dc = 4.0 * (2.0 * err / p2.max(f64::MIN_POSITIVE)).sqrt() + 1e-12;
+        let (a_lo, a_hi) = (
+            libm::acos((ct + dc).min(1.0)),
+            libm::acos((ct - dc).max(-1.0)),
+        );
+        match crate::leg1_certify::postures_in(g, p, a_lo, a_hi) {
+            Ok(found) => {
+                for (alpha, rho1) in found {
+                    let (sin, cos) = alpha.sin_cos();
+                    let l = with_wrapped_alpha(Leg1 {
+                        alpha,
+                        rho1,
+                        sin,
+                        cos,
+                    });
+                    push(l);
+                    push(mirror(p, l));
+                }
+            }
+            Err(()) => {
+                // Two postures of one sign about to merge: the cubic in double-double.
+                let (c_lo, c_hi) = ((ct - dc).max(-1.0), (ct + dc).min(1.0));
+                match crate::certify::poly_roots(&eq9_tracked(g, p), c_lo, c_hi) {
+                    Ok(found) if found.decided_up_to_same_root() => {
+                        certificate = certificate.max(Certificate::Extended);
+                        for c in found.roots {
+                            postures_at_root(g, p, c, push);
+                        }
+                        // At most one root in each (the same solution): taken where leg I's
+                        // equations hold at it.
+                        for [a, b] in found.undecided {
+                            postures_at_root(g, p, 0.5 * (a + b), &mut |l: Leg1| {
+                                if leg1_residual_mm(g, p, &l) <= ACCEPT_RESIDUAL_MM {
+                                    push(l);
+                                }
+                            });
+                        }
+                        continue;
+                    }
+                    _ => {}
+                }
+                certificate = Certificate::Unproved;
+                let cc = ct.clamp(-1.0, 1.0);
+                let alpha = libm::acos(cc);
+                let h2 = leg1_height_sq(g, p, cc).max(0.0);
+                for rho1 in [p.z + h2.sqrt(), p.z - h2.sqrt()] {
+                    let l = polish_leg1(
+                        g,
+                        p,
+                        Leg1 {
+                            alpha,
+                            rho1,
+                            sin: alpha.sin(),
+                            cos: cc,
+                        },
+                    );
+                    push(l);
+                    push(mirror(p, l));
+                }
+            }
+        }
+    }
+    certificate
 }
 
 /// Eqs. (10) and (14) are unchanged by (alpha, z - rho1) -> (-alpha, rho1 - z): the posture at
@@ -477,8 +650,9 @@ pub fn solve_into(m: &Machine, p: &Vector3<f64>, out: &mut IkBranches) {
     let g = &m.module;
     let roots = other_roots(g, p, certified);
     let mut legs1 = ArrayVec::<Leg1, 6>::new();
-    leg1_postures_into(g, p, &roots, certified, &mut legs1);
+    let certificate = leg1_postures_into(g, p, &roots, certified, &mut legs1);
     branches_into(m, p, &legs1, out);
+    out.certificate = certificate;
 }
 
 /// [`solve_into`] for each point of `rows` into its list, [`LANES`] points at a time: the
@@ -580,13 +754,15 @@ fn each_in_lanes_built<'a, const AVX2: bool, const EVERY: bool>(
             let certified: [Option<Leg1>; LANES] =
                 std::array::from_fn(|k| certified[k].then_some(legs[k]));
             let g = &m.module;
-            let mut roots: [ArrayVec<f64, 8>; LANES] = Default::default();
+            let mut roots: [OtherRoots; LANES] = Default::default();
             for k in 0..LANES {
                 roots[k] = other_roots(g, &pts[k], certified[k]);
             }
             let mut postures: [ArrayVec<Leg1, 6>; LANES] = Default::default();
+            let mut certificates = [Certificate::Double; LANES];
             for k in 0..LANES {
-                leg1_postures_into(g, &pts[k], &roots[k], certified[k], &mut postures[k]);
+                certificates[k] =
+                    leg1_postures_into(g, &pts[k], &roots[k], certified[k], &mut postures[k]);
             }
             for (k, out) in outs.enumerate() {
                 // Four postures (two roots of (9) and their mirror images, as on most points):
@@ -597,10 +773,12 @@ fn each_in_lanes_built<'a, const AVX2: bool, const EVERY: bool>(
                         // SAFETY: `AVX2` is set only in the build that runs where the
                         // processor has AVX2 (`each_in_lanes`).
                         unsafe { module_ik_x4::branches_into(m, &pts[k], four, out) };
+                        out.certificate = certificates[k];
                         continue;
                     }
                 }
                 branches_into(m, &pts[k], &postures[k], out);
+                out.certificate = certificates[k];
             }
         },
         |p, out| solve_into(m, p, out),
@@ -632,7 +810,7 @@ fn in_lanes<'a>(
 /// labelled as [`solve`] gives them.
 #[inline(always)]
 fn branches_into(m: &Machine, p: &Vector3<f64>, legs1: &ArrayVec<Leg1, 6>, out: &mut IkBranches) {
-    out.clear();
+    out.reset();
     if !p.iter().all(|v| v.is_finite()) {
         return;
     }
@@ -1058,7 +1236,7 @@ fn working_or_all_into(
 ) {
     match working {
         Some(b) => {
-            out.clear();
+            out.reset();
             out.push(b);
         }
         None => solve_into(m, p, out),

@@ -30,7 +30,7 @@ pub(crate) unsafe fn branches_into(
     legs1: &[Leg1; 4],
     out: &mut IkBranches,
 ) {
-    out.clear();
+    out.reset();
     if !p.iter().all(|v| v.is_finite()) {
         return;
     }

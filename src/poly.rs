@@ -68,10 +68,27 @@ fn trimmed(c: &[f64]) -> &[f64] {
     &c[..n]
 }
 
+/// [`eval_with_error`] with `err[i]` bounding the error of coefficient i itself (from the
+/// formulas that computed it): the bound covers the exact polynomial's value.
+#[inline]
+pub fn eval_with_coefficient_error(c: &[f64], err: &[f64], x: f64) -> (f64, f64) {
+    let (p, rounding) = eval_with_error(c, x);
+    let ax = x.abs();
+    let coef = err.iter().rev().fold(0.0, |acc, e| acc * ax + e);
+    (p, rounding + coef)
+}
+
 /// All real roots of the polynomial `c` (lowest degree first) in [lo, hi], sorted.
 pub fn roots_in(c: &[f64], lo: f64, hi: f64) -> Roots {
+    roots_in_with_error(c, &[], lo, hi)
+}
+
+/// [`roots_in`] where coefficient i of `c` may be off by `err[i]` (missing entries: exact): the
+/// decisions (a sign change, a critical point touching zero) hold for the exact polynomial.
+pub fn roots_in_with_error(c: &[f64], err: &[f64], lo: f64, hi: f64) -> Roots {
     let mut out = Roots::new();
     let c = trimmed(c);
+    let err = &err[..err.len().min(c.len())];
     if c.len() <= 1 {
         return out;
     }
@@ -83,13 +100,19 @@ pub fn roots_in(c: &[f64], lo: f64, hi: f64) -> Roots {
         return out;
     }
     let d = derivative(c);
-    let crit = roots_in(&d, lo, hi);
+    let d_err: ArrayVec<f64, { MAX_DEGREE + 1 }> = err
+        .iter()
+        .enumerate()
+        .skip(1)
+        .map(|(i, e)| e * i as f64)
+        .collect();
+    let crit = roots_in_with_error(&d, &d_err, lo, hi);
     // Refine each root to full precision: the caller's Newton polish on the original equations
     // starts from it, and close pairs of roots must stay apart (an early stop at the rounding
     // level of p lost a mode 1e-5 rad from its twin).
     let noise = 0.0;
     let mut a = lo;
-    let (mut fa, mut ea) = eval_with_error(c, a);
+    let (mut fa, mut ea) = eval_with_coefficient_error(c, err, a);
     if fa.abs() <= ea {
         out.push(Root {
             x: a,
@@ -98,7 +121,7 @@ pub fn roots_in(c: &[f64], lo: f64, hi: f64) -> Roots {
     }
     for k in 0..=crit.len() {
         let b = if k < crit.len() { crit[k].x } else { hi };
-        let (fb, eb) = eval_with_error(c, b);
+        let (fb, eb) = eval_with_coefficient_error(c, err, b);
         let a_zero = fa.abs() <= ea;
         let b_zero = fb.abs() <= eb;
         if !a_zero && !b_zero && (fa < 0.0) != (fb < 0.0) {

@@ -24,12 +24,14 @@ const ROUND_TRIP_RAD: f64 = 1e-9;
 /// Agreement between two evaluations of the same closed form (mm).
 const SAME_FORMULA_MM: f64 = 1e-9;
 /// Near a singularity the joints fix the pose (or the pose the joints) only to about the condition
-/// number times the rounding
-/// error: a result can be off by this much (mm or rad) per unit of the condition number (of the
-/// Jacobians in `condition`) while its residuals are at machine precision.
+/// number times the rounding error: a result can be off by this much (mm or rad) per unit of the
+/// condition number (of the Jacobians in `condition`) while its residuals are at machine
+/// precision: the rounding of a length of about 1000 mm (half a unit in the last place of 1000
+/// is 1.1e-13). (It was 1e-15, a hundred times below that model: a change of the last bit of
+/// theta1 moved one branch with condition 1.01e6 past it, to 1.15e-9 mm.)
 /// Branches with a condition number <= 1e6 (see `condition`; and every working branch) are held
 /// to the 1e-9 bounds.
-const FORWARD_ERROR_PER_COND_MM: f64 = 1e-15;
+const FORWARD_ERROR_PER_COND_MM: f64 = 0.5 * f64::EPSILON * 1000.0;
 /// Tool length used throughout (mm), the AIM paper's.
 const DELTA: f64 = 50.0;
 
