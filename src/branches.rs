@@ -45,10 +45,13 @@ pub enum Reason {
     RodTilt,
     /// The tilting axis theta1 is outside its range (machine kinematics).
     Theta1Range,
+    /// The solver could not prove that its list of branches is complete
+    /// ([`crate::certificate::Certificate::Unproved`]): every branch of such a row carries it.
+    Uncertified,
 }
 
 impl Reason {
-    pub const ALL: [Reason; 9] = [
+    pub const ALL: [Reason; 10] = [
         Reason::Leg1Inverted,
         Reason::Leg2Inverted,
         Reason::Leg3Inverted,
@@ -58,6 +61,7 @@ impl Reason {
         Reason::Rho3Stroke,
         Reason::RodTilt,
         Reason::Theta1Range,
+        Reason::Uncertified,
     ];
 
     pub fn code(self) -> &'static str {
@@ -71,6 +75,7 @@ impl Reason {
             Reason::Rho3Stroke => "rho3_stroke",
             Reason::RodTilt => "rod_tilt",
             Reason::Theta1Range => "theta1_range",
+            Reason::Uncertified => "uncertified",
         }
     }
 

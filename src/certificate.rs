@@ -82,6 +82,16 @@ impl<T, const N: usize> Certified<T, N> {
         self.certificate = Certificate::default();
     }
 
+    /// Marks every item's verdict [`crate::branches::Reason::Uncertified`] when the list is not
+    /// proved complete (no branch of such a row is the machine's without a word).
+    pub fn mark_unproved(&mut self, verdict: impl Fn(&mut T) -> &mut crate::branches::Verdict) {
+        if !self.certificate.proved() {
+            for item in self.items.iter_mut() {
+                verdict(item).add(crate::branches::Reason::Uncertified);
+            }
+        }
+    }
+
     /// Lowers the certificate to `c` if that is weaker.
     pub fn weaken(&mut self, c: Certificate) {
         self.certificate = self.certificate.max(c);

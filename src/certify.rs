@@ -116,8 +116,9 @@ pub(crate) fn factor_roots(
     if depth >= MAX_SPLIT_DEPTH || hi - lo <= 4.0 * f64::EPSILON * lo.abs().max(hi.abs()) {
         return Err(());
     }
-    // Split where the sign can be proved (not on a root: a grid point can be one).
-    let mid = [0.5, 0.3, 0.7]
+    // Split where the sign can be proved (not on a root: a grid point can be one); else in
+    // the middle (a piece with an end of unproved sign is then decided only by exclusion).
+    let mid = [0.5, 0.3, 0.7, 0.4, 0.6, 0.2, 0.8]
         .into_iter()
         .map(|k| lo + k * (hi - lo))
         .find(|&x| sign_at(f, x).is_some())
@@ -305,7 +306,7 @@ pub(crate) const SAME_ROOT_WIDTH: f64 = crate::tolerance::SAME_SOLUTION_RAD;
 #[derive(Debug, Clone, Default)]
 pub(crate) struct DdRoots {
     pub roots: ArrayVec<f64, 16>,
-    pub undecided: ArrayVec<[f64; 2], 4>,
+    pub undecided: ArrayVec<[f64; 2], 8>,
 }
 
 impl DdRoots {
@@ -377,17 +378,11 @@ struct Polys<'a> {
     d3: &'a [Tracked],
 }
 
-/// A point of the chart with p and p' there, each with its error bound.
+/// A point with p there and its error bound.
 #[derive(Debug, Clone, Copy)]
 struct DdPt {
     t: f64,
     p: (f64, f64),
-    d: (f64, f64),
-}
-
-/// Both values beyond `bound` (plus their own errors) on the same side of zero.
-fn same_side(u: (f64, f64), v: (f64, f64), bound: f64) -> bool {
-    (u.0 - u.1 > bound && v.0 - v.1 > bound) || (u.0 + u.1 < -bound && v.0 + v.1 < -bound)
 }
 
 impl Polys<'_> {
@@ -395,15 +390,13 @@ impl Polys<'_> {
         DdPt {
             t,
             p: horner(self.p, t),
-            d: horner(self.d1, t),
         }
     }
 
-    /// On [a, b], a function g with |g''| <= M stays within h^2 M / 8 of its chord (h = b - a):
-    /// with both end values beyond that on one side of zero, g has no zero there. Applied to p
-    /// (no root) and to its derivative (p monotone: one root exactly where p changes sign),
-    /// bisecting what neither decides; the bounds on the second and third derivatives come from
-    /// the coefficients' magnitudes at max |t|.
+    /// Exclusion (p proved nonzero on [a, b]) and monotonicity (p' proved nonzero: one root
+    /// exactly where p changes sign between the ends) by Taylor bounds about the midpoint,
+    /// bisecting what neither decides; the bound on the third derivative comes from the
+    /// coefficients' magnitudes at max |t|.
     fn isolate(
         &self,
         a: DdPt,
@@ -415,30 +408,41 @@ impl Polys<'_> {
         *budget = budget.checked_sub(1).ok_or(())?;
         let tmax = a.t.abs().max(b.t.abs());
         let h = b.t - a.t;
-        let chord = 0.125 * h * h;
-        if same_side(a.p, b.p, chord * bound_on(self.d2, tmax)) {
+        // Taylor's formula about the midpoint, with the first two derivatives computed there
+        // and the third bounded over the interval (r its half-width): p stays within
+        // |p'(m)| r + |p''(m)| r^2 / 2 + M3 r^3 / 6 of p(m), and p' within
+        // |p''(m)| r + M3 r^2 / 2 of p'(m). Sharper than chord bounds with a global second
+        // derivative where p is flat next to a double root (a fold of the kinematics).
+        let r = 0.5 * h;
+        let mid = a.t + r;
+        let (pm, epm) = horner(self.p, mid);
+        let (dm, edm) = horner(self.d1, mid);
+        let (sm, esm) = horner(self.d2, mid);
+        let m3 = bound_on(self.d3, tmax);
+        let (dm_hi, sm_hi) = (dm.abs() + edm, sm.abs() + esm);
+        if pm.abs() - epm > dm_hi * r + sm_hi * r * r * 0.5 + m3 * r * r * r / 6.0 {
             return Ok(());
         }
-        if same_side(a.d, b.d, chord * bound_on(self.d3, tmax)) {
+        if dm.abs() - edm > sm_hi * r + m3 * r * r * 0.5 {
             // Monotone: one root where the ends' signs differ (proved), none where they agree.
             let sign = |v: (f64, f64)| (v.0.abs() > v.1).then_some(v.0 < 0.0);
-            if let (Some(na), Some(nb)) = (sign(a.p), sign(b.p)) {
-                if na != nb {
-                    let t = self.refine(a.t, b.t, na);
-                    out.roots.try_push(t).map_err(|_| ())?;
+            match (sign(a.p), sign(b.p)) {
+                (Some(na), Some(nb)) => {
+                    if na != nb {
+                        let t = self.refine(a.t, b.t, na);
+                        out.roots.try_push(t).map_err(|_| ())?;
+                    }
+                    return Ok(());
                 }
-                return Ok(());
+                // Both ends within rounding of zero: the whole (monotone) interval is, and holds
+                // at most one root that no precision here can place.
+                (None, None) => return self.undecided(a.t, b.t, out),
+                // One end within rounding: bisection walks to the edge of that band.
+                _ => {}
             }
         }
         if depth >= MAX_SPLIT_DEPTH || h <= 4.0 * f64::EPSILON * tmax.max(1e-300) {
-            // Adjacent undecided pieces make one interval.
-            return match out.undecided.last_mut() {
-                Some(last) if last[1] >= a.t => {
-                    last[1] = b.t;
-                    Ok(())
-                }
-                _ => out.undecided.try_push([a.t, b.t]).map_err(|_| ()),
-            };
+            return self.undecided(a.t, b.t, out);
         }
         // Split where the sign of p can be proved.
         let m = [0.5, 0.3, 0.7]
@@ -448,6 +452,17 @@ impl Polys<'_> {
             .unwrap_or_else(|| self.at(a.t + 0.5 * h));
         self.isolate(a, m, depth + 1, budget, out)?;
         self.isolate(m, b, depth + 1, budget, out)
+    }
+
+    /// Records [a, b] as undecided; adjacent undecided pieces make one interval.
+    fn undecided(&self, a: f64, b: f64, out: &mut DdRoots) -> Result<(), ()> {
+        match out.undecided.last_mut() {
+            Some(last) if last[1] >= a => {
+                last[1] = b;
+                Ok(())
+            }
+            _ => out.undecided.try_push([a, b]).map_err(|_| ()),
+        }
     }
 
     /// The root of p in [a, b] (p monotone there, negative at a when `neg_at_a`): Newton steps

@@ -263,8 +263,10 @@ impl Factor for FkFactor<'_> {
 /// Decides each interval of `ambiguous` (alpha, rad; from `Trig::roots_certified`), pushing the
 /// start pose of every mode it proves there into `starts`, and returns the strongest method it
 /// needed. `allowed` receives the starts of intervals narrower than
-/// [`certify::SAME_ROOT_WIDTH`] that double-double could not decide (at most one mode each, which
-/// the start finds if it is real); `fallback` best-effort starts where nothing could be proved.
+/// [`certify::SAME_ROOT_WIDTH`] that double-double could not decide (at most one alpha each,
+/// which the start finds if it is real; those intervals go to `undecided`: at a zero of
+/// condition (21) one alpha carries two modes), `fallback` best-effort starts where nothing
+/// could be proved.
 #[cold]
 #[inline(never)]
 pub(crate) fn resolve(
@@ -274,9 +276,14 @@ pub(crate) fn resolve(
     starts: &mut ArrayVec<ProvedStart, 40>,
     allowed: &mut ArrayVec<ProvedStart, 40>,
     fallback: &mut ArrayVec<ProvedStart, 40>,
+    undecided: &mut ArrayVec<[f64; 2], 8>,
 ) -> Resolution {
     let fi = forms::<Iv>(g, rho);
     let ff = forms::<f64>(g, rho);
+    if !characteristic_error(g, rho).is_finite() {
+        // The elimination overflows: nothing can be proved (and nothing isolated).
+        return Resolution::Unproved;
+    }
     let factors = [1.0, -1.0].map(|sigma| FkFactor {
         iv: &fi,
         f64: &ff,
@@ -307,10 +314,10 @@ pub(crate) fn resolve(
             Ok(found) if found.decided_up_to_same_root() => {
                 worst = worst.max(Resolution::Extended);
                 found.roots.iter().for_each(|&x| push(starts, x));
-                found
-                    .undecided
-                    .iter()
-                    .for_each(|[a, b]| push(allowed, 0.5 * (a + b)));
+                for [a, b] in found.undecided {
+                    push(allowed, 0.5 * (a + b));
+                    let _ = undecided.try_push([a, b]);
+                }
             }
             other => {
                 // Best effort where nothing is proved: what was found, and the midpoints.
@@ -377,6 +384,19 @@ pub fn factor_root_angles(g: &ModuleGeometry, rho: &Sliders, lo: f64, hi: f64) -
     });
     let roots = certify::all_factor_roots(&factors, lo, hi).ok()?;
     Some(roots.iter().map(|r| r.1).collect())
+}
+
+/// For tests: what double-double proves over [lo, hi]: roots and undecided intervals, as angles.
+#[doc(hidden)]
+pub fn dd_root_angles_full(
+    g: &ModuleGeometry,
+    rho: &Sliders,
+    lo: f64,
+    hi: f64,
+) -> Option<(Vec<f64>, Vec<[f64; 2]>)> {
+    let tf = forms::<Tracked>(g, rho);
+    let out = certify::dd_roots(|at_pi| half_angle_poly(&tf, at_pi), lo, hi).ok()?;
+    Some((out.roots.to_vec(), out.undecided.to_vec()))
 }
 
 /// For tests: the proved roots of F over [lo, hi] in double-double, as angles.

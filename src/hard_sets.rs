@@ -35,8 +35,10 @@ pub enum HardSet {
     EqualOuterSliders,
     /// sin(alpha) = 0 with cos(alpha) < 0: alpha = pi, where t = tan(alpha / 2) is infinite.
     AlphaPi,
-    /// L2^2 - dx^2 - dy^2 = 0 for leg II (the square root of eq. (12)): a fully stretched rod.
-    StretchedLeg2,
+    /// A leg's square root at zero (eqs. (11)-(13): leg I's height, L2^2 - dx^2 - dy^2 for leg
+    /// II, the same for leg III): a fully stretched rod, where the branch meets its mirror in
+    /// that leg and ends.
+    StretchedLeg,
     /// det A = 0 (A the Jacobian of (3)-(6) in the pose): a parallel singularity, where two
     /// assembly modes meet and F has a double root; next to it, two close simple roots.
     ParallelSingularity,
@@ -53,7 +55,7 @@ impl HardSet {
         HardSet::YpZero,
         HardSet::EqualOuterSliders,
         HardSet::AlphaPi,
-        HardSet::StretchedLeg2,
+        HardSet::StretchedLeg,
         HardSet::ParallelSingularity,
         HardSet::Cubic9DoubleRoot,
     ];
@@ -66,7 +68,7 @@ impl HardSet {
             HardSet::YpZero => "yp_zero",
             HardSet::EqualOuterSliders => "rho2_eq_rho3",
             HardSet::AlphaPi => "alpha_pi",
-            HardSet::StretchedLeg2 => "stretched_leg2",
+            HardSet::StretchedLeg => "stretched_leg",
             HardSet::ParallelSingularity => "parallel_singularity",
             HardSet::Cubic9DoubleRoot => "cubic9_double_root",
         }
@@ -93,10 +95,20 @@ impl HardSet {
                     f64::NAN
                 }
             }
-            HardSet::StretchedLeg2 => {
+            HardSet::StretchedLeg => {
+                let u = p.x + g.dx1;
+                let k1 = g.l1 * g.l1 - g.r_big1 * g.r_big1 - g.r_small1 * g.r_small1
+                    + 2.0 * g.r_big1 * g.r_small1 * c;
                 let dx = p.x + g.dx2;
-                let dy = p.y - g.r_big2 * c + g.r4;
-                g.l2 * g.l2 - dx * dx - dy * dy
+                let dy2 = p.y - g.r_big2 * c + g.r4;
+                let dy3 = p.y + g.r_big2 * c - g.r4;
+                [
+                    (k1 - u * u - p.y * p.y) / (g.l1 * g.l1),
+                    (g.l2 * g.l2 - dx * dx - dy2 * dy2) / (g.l2 * g.l2),
+                    (g.l3 * g.l3 - dx * dx - dy3 * dy3) / (g.l3 * g.l3),
+                ]
+                .into_iter()
+                .fold(f64::INFINITY, f64::min)
             }
             HardSet::ParallelSingularity => {
                 let pose = crate::module_geometry::ModulePose {
@@ -159,22 +171,30 @@ pub fn construct(
 ) -> Vec<Constructed> {
     let dir = dir.normalize();
     let at = |s: f64| p0 + dir * s;
-    // Scan outwards from s = 0 in both directions, following the branch step by step.
     let step = reach / SCAN_STEPS as f64;
+    // The branch at s, followed from `prev`, with the quantity there. A stretched leg is a fold:
+    // past it the branch does not exist (the square root's argument would be negative), which
+    // counts as the quantity's other sign; for the other sets a lost branch ends the search.
+    let probe = |s: f64, prev: &IkBranch| -> Option<(IkBranch, f64)> {
+        let p = at(s);
+        match follow(m, &p, prev) {
+            Some(b) if branch_distance(&b, prev) <= 50.0 * step.max(1.0) => {
+                Some((b, set.quantity(m, &p, &b)))
+            }
+            _ if set == HardSet::StretchedLeg => Some((*prev, -1.0)),
+            _ => None,
+        }
+    };
+    // Scan outwards from s = 0 in both directions, following the branch step by step.
     let mut bracket = None;
     'sides: for side in [1.0, -1.0] {
         let mut prev = *branch;
         let mut q_prev = set.quantity(m, p0, &prev);
         for k in 1..=SCAN_STEPS {
             let s = side * step * k as f64;
-            let p = at(s);
-            let Some(b) = follow(m, &p, &prev) else {
+            let Some((b, q)) = probe(s, &prev) else {
                 continue 'sides;
             };
-            if branch_distance(&b, &prev) > 50.0 * step.max(1.0) {
-                continue 'sides; // jumped to another branch
-            }
-            let q = set.quantity(m, &p, &b);
             if q.is_finite() && q_prev.is_finite() && (q < 0.0) != (q_prev < 0.0) {
                 bracket = Some((s - side * step, prev, s, b));
                 break 'sides;
@@ -192,11 +212,9 @@ pub fn construct(
         if sm == sa || sm == sb {
             break;
         }
-        let p = at(sm);
-        let Some(bm) = follow(m, &p, &ba) else {
+        let Some((bm, q)) = probe(sm, &ba) else {
             return Vec::new();
         };
-        let q = set.quantity(m, &p, &bm);
         if !q.is_finite() {
             return Vec::new();
         }
@@ -205,6 +223,11 @@ pub fn construct(
         } else {
             (sb, bb) = (sm, bm);
         }
+    }
+    // A branch lost for another reason than a stretched leg (two postures meeting) is not this
+    // set.
+    if set == HardSet::StretchedLeg && set.quantity(m, &at(sa), &ba).abs() > 1e-9 {
+        return Vec::new();
     }
     let star = sa;
     let near = if (sb - sa).abs() < 1.0 { ba } else { bb };
@@ -439,6 +462,227 @@ pub fn random_geometries(count: usize, seed: u64) -> Vec<Machine> {
         }
     }
     out
+}
+
+/// A constructed pose matches a solution within these (mm, rad): its own accuracy is that of
+/// the kinematics it came from, about 1e-12 mm.
+pub const MATCH_MM: f64 = 1e-6;
+pub const MATCH_RAD: f64 = 1e-8;
+/// The same at a fold (a parallel singularity, or two leg-I postures meeting): there the pose is
+/// fixed by the joints only to the square root of their rounding (about 1e-5 mm).
+pub const FOLD_MATCH_MM: f64 = 1e-4;
+pub const FOLD_MATCH_RAD: f64 = 1e-6;
+/// Within this offset (mm) of a fold the line of construction maps to joints within rounding of
+/// the fold (it is tangent to it): a pair of solutions there may be real or not for the rounded
+/// joints, and either answer is correct when it is proved.
+pub const FOLD_ROUNDING_OFFSET_MM: f64 = 1e-5;
+
+/// What a batch of constructed poses showed.
+#[derive(Debug, Clone, Default)]
+pub struct Tally {
+    pub poses: u64,
+    /// Poses whose solution the solver did not return, the first few described (with the
+    /// joints that reproduce them).
+    pub lost: u64,
+    /// Answers proved by the factors, in double-double, or not proved.
+    pub factored: u64,
+    pub extended: u64,
+    pub unproved: u64,
+    pub examples: Vec<String>,
+}
+
+impl Tally {
+    fn note(&mut self, what: String) {
+        if self.examples.len() < 10 {
+            self.examples.push(what);
+        }
+    }
+
+    fn count(&mut self, c: crate::certificate::Certificate) {
+        use crate::certificate::Certificate;
+        match c {
+            Certificate::Double => {}
+            Certificate::Factored => self.factored += 1,
+            Certificate::Extended => self.extended += 1,
+            _ => self.unproved += 1,
+        }
+    }
+
+    pub fn add(&mut self, o: Tally) {
+        self.poses += o.poses;
+        self.lost += o.lost;
+        self.factored += o.factored;
+        self.extended += o.extended;
+        self.unproved += o.unproved;
+        for e in o.examples {
+            self.note(e);
+        }
+    }
+}
+
+/// Whether a solution (p, alpha, rho) matches the constructed pose, with the fold's tolerance
+/// where the set is a fold.
+fn matches(set: HardSet, c: &Constructed, p: &Vector3<f64>, alpha: f64, rho: &Sliders) -> bool {
+    let fold = matches!(
+        set,
+        HardSet::ParallelSingularity | HardSet::Cubic9DoubleRoot
+    );
+    let (mm, rad) = if fold {
+        (FOLD_MATCH_MM, FOLD_MATCH_RAD)
+    } else {
+        (MATCH_MM, MATCH_RAD)
+    };
+    (p - c.p).amax() < mm && (rho - c.rho).amax() < mm && wrap_angle(alpha - c.alpha).abs() < rad
+}
+
+/// The fold's allowance: within rounding of a fold, a proved answer without the pose is right.
+fn fold_allows(set: HardSet, c: &Constructed, proved: bool) -> bool {
+    matches!(
+        set,
+        HardSet::ParallelSingularity | HardSet::Cubic9DoubleRoot
+    ) && c.offset_mm.abs() <= FOLD_ROUNDING_OFFSET_MM
+        && proved
+}
+
+/// The forward kinematics on poses built on `set` from `starts` random starts (each giving up
+/// to eleven poses): the modes of each pose's sliders must contain it.
+pub fn check_fk(m: &Machine, set: HardSet, starts: usize, rng: &mut Sampler) -> Tally {
+    let mut t = Tally::default();
+    let mut built = 0;
+    for _ in 0..20 * starts.max(1) {
+        if built >= starts {
+            break;
+        }
+        let Some((p0, b)) = random_start(m, rng) else {
+            continue;
+        };
+        let poses = construct(m, set, &p0, &rng.direction(), &b, 300.0);
+        built += usize::from(!poses.is_empty());
+        for c in poses {
+            t.poses += 1;
+            let modes = crate::module_fk::solve(m, &c.rho);
+            t.count(modes.certificate);
+            let found = modes
+                .iter()
+                .any(|f| matches(set, &c, &f.pose.p, f.pose.alpha, &c.rho))
+                || fold_allows(set, &c, modes.certificate.proved());
+            if !found || !modes.certificate.proved() {
+                t.lost += u64::from(!found);
+                t.note(format!(
+                    "{}: `verne modes --joints {},{},{}` {} the pose P = ({}, {}, {}), alpha = {} rad ({}, offset {:e} mm; {})",
+                    m.name,
+                    c.rho.x,
+                    c.rho.y,
+                    c.rho.z,
+                    if found { "has" } else { "lacks" },
+                    c.p.x,
+                    c.p.y,
+                    c.p.z,
+                    c.alpha,
+                    set.name(),
+                    c.offset_mm,
+                    modes.certificate.code()
+                ));
+            }
+        }
+    }
+    t
+}
+
+/// The module's inverse kinematics on points built on `set` from the slider side
+/// ([`construct_from_sliders`]): the branches of each point must contain its sliders.
+pub fn check_ik(m: &Machine, set: HardSet, starts: usize, rng: &mut Sampler) -> Tally {
+    let mut t = Tally::default();
+    let mut built = 0;
+    for _ in 0..20 * starts.max(1) {
+        if built >= starts {
+            break;
+        }
+        let Some((rho0, mode)) = random_slider_start(m, rng) else {
+            continue;
+        };
+        let cs = construct_from_sliders(m, set, &rho0, &rng.direction(), &mode, 300.0);
+        built += usize::from(!cs.is_empty());
+        for c in cs {
+            t.poses += 1;
+            let ik = module_ik::solve(m, &c.p);
+            t.count(ik.certificate);
+            let found = ik.iter().any(|b| matches(set, &c, &c.p, b.alpha, &b.rho))
+                || fold_allows(set, &c, ik.certificate.proved());
+            if !found || !ik.certificate.proved() {
+                t.lost += u64::from(!found);
+                t.note(format!(
+                    "{}: `verne modes --pose={},{},{}` {} the branch alpha = {} rad, rho = ({}, {}, {}) ({}, offset {:e} mm; {})",
+                    m.name,
+                    c.p.x,
+                    c.p.y,
+                    c.p.z,
+                    if found { "has" } else { "lacks" },
+                    c.alpha,
+                    c.rho.x,
+                    c.rho.y,
+                    c.rho.z,
+                    set.name(),
+                    c.offset_mm,
+                    ik.certificate.code()
+                ));
+            }
+        }
+    }
+    t
+}
+
+/// The machine's inverse kinematics on tool poses whose theta1 equation has its double root
+/// (Table II of IFToMM 2007 along the pose: at the theta1 where alpha = 0 the platform point has
+/// y_p = 0 and rho1 - z_p takes both signs) or is next to it: P = (x, offset, z) with a module
+/// branch at alpha near 0, random theta1 within its range and theta2, the tool pose from eq. (26)
+/// of AIM 2007. The machine's branches must contain the joints.
+pub fn check_machine_ik(m: &Machine, starts: usize, rng: &mut Sampler) -> Tally {
+    use crate::machine_kin::{machine_ik, tool_pose_eq26};
+    let mut t = Tally::default();
+    let mut built = 0;
+    for _ in 0..50 * starts.max(1) {
+        if built >= starts {
+            break;
+        }
+        let Some((p0, _)) = random_start(m, rng) else {
+            continue;
+        };
+        let theta1 = rng.uniform(m.limits.theta1_min, m.limits.theta1_max);
+        let theta2 = rng.uniform(-3.0, 3.0);
+        let mut any = false;
+        for off in OFFSETS_MM {
+            let p = Vector3::new(p0.x, off, p0.z);
+            for b in module_ik::solve(m, &p) {
+                if b.alpha.abs() > 0.1 {
+                    continue;
+                }
+                any = true;
+                t.poses += 1;
+                let module = crate::module_geometry::ModulePose { p, alpha: b.alpha };
+                let tool = tool_pose_eq26(&m.table, &module, theta1, theta2, m.tool_length);
+                let ik = machine_ik(m, &tool, m.tool_length);
+                t.count(ik.certificate);
+                let found = ik.iter().any(|x| {
+                    (x.rho - b.rho).amax() < MATCH_MM
+                        && wrap_angle(x.theta1 - theta1).abs() < MATCH_RAD
+                });
+                if !found || !ik.certificate.proved() {
+                    t.lost += u64::from(!found);
+                    t.note(format!(
+                        "{}: tool pose {:?} {} the joints rho = {:?}, theta1 = {theta1} rad ({})",
+                        m.name,
+                        tool,
+                        if found { "has" } else { "lacks" },
+                        b.rho,
+                        ik.certificate.code()
+                    ));
+                }
+            }
+        }
+        built += usize::from(any);
+    }
+    t
 }
 
 #[cfg(test)]

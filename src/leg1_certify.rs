@@ -231,6 +231,9 @@ pub(crate) fn resolve(
 ) -> Resolution {
     let fi = path_forms::<Iv>(m, w, sp, cp);
     let ff = path_forms::<f64>(m, w, sp, cp);
+    if !equation_error(m, w, sp, cp).is_finite() {
+        return Resolution::Unproved;
+    }
     let factors = [1.0, -1.0].map(|sigma| Posture {
         iv: &fi,
         f64: &ff,

@@ -105,6 +105,11 @@ impl fmt::Display for MachineError {
 
 impl std::error::Error for MachineError {}
 
+/// Largest length of the module a machine file may give (mm): the forward kinematics' degree-8
+/// polynomial has coefficients of the eighth power of the lengths, and 1e30^8 is near the largest
+/// double; a kilometre is 1e6 mm.
+pub const MAX_LENGTH_MM: f64 = 1e30;
+
 /// How a key's value is read and checked.
 #[derive(Clone, Copy)]
 enum Check {
@@ -361,6 +366,27 @@ impl Machine {
                 message,
             })
         };
+        let lengths = [
+            ("module.D1", m.dx1),
+            ("module.D2", m.dx2),
+            ("module.R1", m.r_big1),
+            ("module.r1", m.r_small1),
+            ("module.L1", m.l1),
+            ("module.R2", m.r_big2),
+            ("module.r4", m.r4),
+            ("module.L2", m.l2),
+            ("module.L3", m.l3),
+        ];
+        for (key, v) in lengths {
+            if v.abs() > MAX_LENGTH_MM {
+                push(
+                    key,
+                    format!(
+                        "{v:e} mm is beyond {MAX_LENGTH_MM:e} mm: the forward kinematics' degree-8 polynomial in it would overflow"
+                    ),
+                );
+            }
+        }
         if (m.dx1 - m.dx2).abs() < 1e-6 {
             push(
                 "module.D2",

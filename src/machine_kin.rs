@@ -141,8 +141,8 @@ impl MachineFkMode {
     }
 }
 
-/// Every assembly mode of the machine for one set of joints.
-pub type MachineFkModes = ArrayVec<MachineFkMode, MAX_MACHINE_FK_MODES>;
+/// Every assembly mode of the machine for one set of joints, with the module's certificate.
+pub type MachineFkModes = Certified<MachineFkMode, MAX_MACHINE_FK_MODES>;
 
 fn trans(v: Vector3<f64>) -> Matrix4<f64> {
     Matrix4::new_translation(&v)
@@ -529,6 +529,7 @@ pub fn machine_ik_into(
         }
     }
     out.certificate = certificate;
+    out.mark_unproved(|b| &mut b.verdict);
     // Usually in order already (roots by increasing theta1, a posture's four branches by
     // (s2, s3)): sorted only when that check fails.
     let in_order = out
@@ -552,7 +553,9 @@ pub fn machine_fk(
     if !(theta1.is_finite() && theta2.is_finite() && tool_length.is_finite()) {
         return out;
     }
-    for mode in crate::module_fk::solve(m, rho) {
+    let modes = crate::module_fk::solve(m, rho);
+    out.certificate = modes.certificate;
+    for mode in modes {
         let tool = tool_pose_eq26(&m.table, &mode.pose, theta1, theta2, tool_length);
         let mut verdict = mode.verdict;
         if !theta1_in_limits(m, theta1) {
@@ -620,6 +623,8 @@ pub enum PathError {
     NoWorkingBranch {
         /// Number of real branches.
         real_branches: usize,
+        /// False when the solver could not prove the branches complete (status `uncertified`).
+        proved: bool,
         /// See above.
         nearest: Option<MachineIkBranch>,
     },
@@ -631,9 +636,13 @@ impl std::fmt::Display for PathError {
             PathError::Axis(e) => e.fmt(f),
             PathError::NoWorkingBranch {
                 real_branches,
+                proved,
                 nearest,
             } => {
                 write!(f, "no working branch ({real_branches} real branches")?;
+                if !proved {
+                    f.write_str(", not proved complete")?;
+                }
                 if let Some(b) = nearest {
                     write!(
                         f,
@@ -682,6 +691,8 @@ pub struct PathCandidates {
     all: ArrayVec<Candidate, { 2 * MAX_MACHINE_IK_BRANCHES }>,
     near_singular: bool,
     needs_previous: bool,
+    /// The weakest certificate of the orientation solutions' branch lists.
+    pub certificate: Certificate,
 }
 
 impl PathCandidates {
@@ -735,6 +746,7 @@ pub fn path_candidates_into(
     out.all.clear();
     out.near_singular = false;
     out.needs_previous = false;
+    out.certificate = Certificate::Double;
     match orientation {
         ToolOrientation::Angles(a) => {
             out.near_singular = a.phi1.sin().abs() < crate::orientation::ROTARY_SINGULAR_CONE_RAD;
@@ -768,6 +780,7 @@ pub fn path_candidates_into(
             phi2: angles.phi2,
         };
         machine_ik_into(m, &pose, tool_length, &mut branches);
+        out.certificate = out.certificate.max(branches.certificate);
         for &branch in &branches {
             out.all.push(Candidate {
                 branch,
@@ -853,6 +866,7 @@ impl PathState {
                         None => {
                             return Err(PathError::NoWorkingBranch {
                                 real_branches: all.len(),
+                                proved: candidates.certificate.proved(),
                                 nearest: cont.map(|c| c.branch),
                             });
                         }
@@ -884,6 +898,7 @@ impl PathState {
                         None => {
                             return Err(PathError::NoWorkingBranch {
                                 real_branches: all.len(),
+                                proved: candidates.certificate.proved(),
                                 nearest: smallest(&|c| machine_kind(&c)).map(|c| c.branch),
                             });
                         }

@@ -200,7 +200,8 @@ impl RowJob for MachineIk {
         if self.all {
             let branches: ArrayVec<_, { 2 * MAX_MACHINE_IK_BRANCHES }> =
                 candidates.iter().collect();
-            return emit_every(out, &branches, |(b, orientation, theta2)| {
+            let proved = candidates.certificate.proved();
+            return emit_every(out, &branches, proved, |(b, orientation, theta2)| {
                 let values = [
                     Cell::Int((*orientation).into()),
                     Cell::Num(b.rho.x),
@@ -245,8 +246,15 @@ fn bad_row(out: &mut RowWriter<'_>, e: &PathError, all: bool) -> Result<RowOutco
     let status = match e {
         PathError::Axis(_) => Cell::Str("invalid_axis"),
         PathError::NoWorkingBranch {
-            real_branches: 0, ..
+            real_branches: 0,
+            proved: true,
+            ..
         } => Cell::Str("unreachable"),
+        PathError::NoWorkingBranch {
+            real_branches: 0,
+            proved: false,
+            ..
+        } => Cell::Str("uncertified"),
         PathError::NoWorkingBranch {
             nearest: Some(b), ..
         } if b.verdict.only_limits() => Cell::Verdict(b.verdict),
@@ -339,7 +347,7 @@ impl RowJob for MachineFkAll {
         modes: &MachineFkModes,
         out: &mut RowWriter<'_>,
     ) -> Result<RowOutcome, VerneError> {
-        emit_every(out, modes, machine_fk_parts)
+        emit_every(out, modes, modes.certificate.proved(), machine_fk_parts)
     }
 }
 
@@ -356,7 +364,12 @@ impl RowJob for MachineFkWorking {
 
     fn solve(&self, inputs: &[f64], solved: &mut Working<MachineFkMode>) {
         let modes = machine_fk_row(&self.machine, self.tool_length, inputs);
-        *solved = Working::of(&modes, working_machine_mode(&modes), |m| m.verdict);
+        *solved = Working::of(
+            &modes,
+            working_machine_mode(&modes),
+            modes.certificate.proved(),
+            |m| m.verdict,
+        );
     }
 
     fn emit(

@@ -314,6 +314,7 @@ fn solve_built<const AVX2: bool>(m: &Machine, rho: &Sliders) -> FkModes {
     // Starts of intervals too narrow for double-double that hold at most one mode each: a mode
     // they find is expected, none is too.
     let mut allowed: ArrayVec<ProvedStart, 40> = ArrayVec::new();
+    let mut undecided: ArrayVec<[f64; 2], 8> = ArrayVec::new();
     if !iso.ambiguous.is_empty() {
         let resolution = fk_certify::resolve(
             g,
@@ -322,6 +323,7 @@ fn solve_built<const AVX2: bool>(m: &Machine, rho: &Sliders) -> FkModes {
             &mut proved,
             &mut allowed,
             &mut others,
+            &mut undecided,
         );
         out.weaken(Certificate::from(resolution));
     }
@@ -337,9 +339,16 @@ fn solve_built<const AVX2: bool>(m: &Machine, rho: &Sliders) -> FkModes {
             continue;
         }
         let alpha = wrap_angle(sc.0.atan2(sc.1));
+        // Inside an interval double-double left undecided (narrower than the same-solution
+        // tolerance), the two points are what that interval holds: expected, not a surprise.
+        let near = |x: f64| wrap_angle(x - alpha).abs() <= 1e-12;
+        let expected = undecided.iter().any(|&[a, b]| {
+            near(a) || near(b) || (wrap_angle(alpha - a) >= 0.0 && wrap_angle(b - alpha) >= 0.0)
+        });
         for pose in fixed_alpha_points(g, rho, alpha, sc) {
             if residual_mm(g, &pose, rho) <= ACCEPT_RESIDUAL_MM {
-                let _ = others.try_push(ProvedStart { pose, sc });
+                let to = if expected { &mut allowed } else { &mut others };
+                let _ = to.try_push(ProvedStart { pose, sc });
             }
         }
     }
@@ -390,6 +399,7 @@ fn solve_built<const AVX2: bool>(m: &Machine, rho: &Sliders) -> FkModes {
             .total_cmp(&b.pose.alpha)
             .then(a.config.cmp(&b.config))
     });
+    out.mark_unproved(|m| &mut m.verdict);
     out
 }
 

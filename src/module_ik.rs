@@ -653,6 +653,7 @@ pub fn solve_into(m: &Machine, p: &Vector3<f64>, out: &mut IkBranches) {
     let certificate = leg1_postures_into(g, p, &roots, certified, &mut legs1);
     branches_into(m, p, &legs1, out);
     out.certificate = certificate;
+    out.mark_unproved(|b| &mut b.verdict);
 }
 
 /// [`solve_into`] for each point of `rows` into its list, [`LANES`] points at a time: the
@@ -774,11 +775,13 @@ fn each_in_lanes_built<'a, const AVX2: bool, const EVERY: bool>(
                         // processor has AVX2 (`each_in_lanes`).
                         unsafe { module_ik_x4::branches_into(m, &pts[k], four, out) };
                         out.certificate = certificates[k];
+                        out.mark_unproved(|b| &mut b.verdict);
                         continue;
                     }
                 }
                 branches_into(m, &pts[k], &postures[k], out);
                 out.certificate = certificates[k];
+                out.mark_unproved(|b| &mut b.verdict);
             }
         },
         |p, out| solve_into(m, p, out),

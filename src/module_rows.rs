@@ -71,7 +71,7 @@ impl RowJob for ModuleIkAll {
     }
 
     fn emit(&mut self, b: &IkBranches, out: &mut RowWriter<'_>) -> Result<RowOutcome, VerneError> {
-        emit_every(out, b, ik_parts)
+        emit_every(out, b, b.certificate.proved(), ik_parts)
     }
 }
 
@@ -145,12 +145,18 @@ impl<T> Default for Working<T> {
 
 impl<T: Copy> Working<T> {
     /// The working branch of `branches` (`working`), or the status that says why there is none.
-    pub fn of(branches: &[T], working: Option<&T>, verdict: impl Fn(&T) -> Verdict) -> Working<T> {
+    pub fn of(
+        branches: &[T],
+        working: Option<&T>,
+        proved: bool,
+        verdict: impl Fn(&T) -> Verdict,
+    ) -> Working<T> {
         match working {
             Some(w) => Working::Found(*w),
             None => Working::Missing(missing_status(
                 branches.iter().map(verdict),
                 branches.is_empty(),
+                proved,
             )),
         }
     }
@@ -166,32 +172,41 @@ impl<T: Copy> Working<T> {
 
 impl Working<IkBranch> {
     fn of_ik(branches: &IkBranches) -> Working<IkBranch> {
-        Working::of(branches, module_ik::working(branches), |b| b.verdict)
+        Working::of(
+            branches,
+            module_ik::working(branches),
+            branches.certificate.proved(),
+            |b| b.verdict,
+        )
     }
 }
 
 impl Working<FkMode> {
     fn of_fk(modes: &FkModes) -> Working<FkMode> {
-        Working::of(modes, module_fk::working(modes), |m| m.verdict)
+        Working::of(
+            modes,
+            module_fk::working(modes),
+            modes.certificate.proved(),
+            |m| m.verdict,
+        )
     }
 }
 
 /// One row per branch (`branch`, values, `s1,s2,s3`, `working`, `status`), or one
-/// `unreachable` row when there is none.
+/// `unreachable` row when there is none (`uncertified` when the solver could not prove that).
 pub fn emit_every<T, const N: usize>(
     out: &mut RowWriter<'_>,
     branches: &[T],
+    proved: bool,
     parts: impl Fn(&T) -> ([Cell; N], Config, Verdict),
 ) -> Result<RowOutcome, VerneError> {
     let mut cells = ArrayVec::<Cell, 24>::new();
     if branches.is_empty() {
+        let status = Cell::Str(if proved { "unreachable" } else { "uncertified" });
         cells.extend(std::iter::repeat_n(Cell::Empty, N + 5));
-        cells.push(Cell::Str("unreachable"));
+        cells.push(status);
         out.row(&cells)?;
-        return Ok(RowOutcome {
-            ok: false,
-            status: Cell::Str("unreachable"),
-        });
+        return Ok(RowOutcome { ok: false, status });
     }
     for (k, b) in branches.iter().enumerate() {
         let (values, config, verdict) = parts(b);
@@ -204,8 +219,8 @@ pub fn emit_every<T, const N: usize>(
         out.row(&cells)?;
     }
     Ok(RowOutcome {
-        ok: true,
-        status: Cell::Str("ok"),
+        ok: proved,
+        status: Cell::Str(if proved { "ok" } else { "uncertified" }),
     })
 }
 
@@ -232,11 +247,12 @@ pub fn emit_working<T, const N: usize>(
     Ok(RowOutcome { ok, status })
 }
 
-/// Why a row has no working branch: `unreachable` (no real branch), the failed limits of the
-/// machine-type branch when only limits fail, or `no_working_branch`.
-pub fn missing_status(verdicts: impl Iterator<Item = Verdict>, empty: bool) -> Cell {
+/// Why a row has no working branch: `unreachable` (no real branch; `uncertified` when that
+/// could not be proved), the failed limits of the machine-type branch when only limits fail
+/// (`uncertified` among them for an unproved row), or `no_working_branch`.
+pub fn missing_status(verdicts: impl Iterator<Item = Verdict>, empty: bool, proved: bool) -> Cell {
     if empty {
-        return Cell::Str("unreachable");
+        return Cell::Str(if proved { "unreachable" } else { "uncertified" });
     }
     let mut limits_only = verdicts.filter(|v| v.only_limits());
     match limits_only.next() {
@@ -289,7 +305,7 @@ impl RowJob for ModuleFkAll {
     }
 
     fn emit(&mut self, modes: &FkModes, out: &mut RowWriter<'_>) -> Result<RowOutcome, VerneError> {
-        emit_every(out, modes, fk_parts)
+        emit_every(out, modes, modes.certificate.proved(), fk_parts)
     }
 }
 
@@ -400,7 +416,7 @@ mod tests {
                 working: Option<&'a T>,
                 verdict: impl Fn(&T) -> Verdict,
             ) -> Result<&'a T, Cell> {
-                working.ok_or_else(|| missing_status(all.iter().map(verdict), all.is_empty()))
+                working.ok_or_else(|| missing_status(all.iter().map(verdict), all.is_empty(), true))
             }
             if self.fk {
                 let found = picked(&kept.fk, module_fk::working(&kept.fk), |m| m.verdict);

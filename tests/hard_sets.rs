@@ -4,111 +4,89 @@
 //! ten random valid geometries; `cargo run --release --example hard_sets` runs the full count
 //! (docs/reliability.md).
 
-use verne::hard_sets::{HardSet, Sampler, construct, random_geometries, random_start};
+mod common;
+
+use verne::hard_sets::{
+    HardSet, Sampler, Tally, check_fk, check_ik, check_machine_ik, random_geometries,
+};
 use verne::machine::Machine;
-use verne::module_fk::{self, Certificate};
-use verne::module_ik::wrap_angle;
+use verne::module_fk;
 
-/// A mode matches the constructed pose within these (mm, rad): the pose's own accuracy is that
-/// of the inverse kinematics, about 1e-12 mm.
-const MATCH_MM: f64 = 1e-6;
-const MATCH_RAD: f64 = 1e-8;
-/// The same at a parallel singularity (see the test).
-const FOLD_MATCH_MM: f64 = 1e-4;
-const FOLD_MATCH_RAD: f64 = 1e-6;
-const FOLD_ROUNDING_OFFSET_MM: f64 = 1e-5;
-
-#[derive(Default, Debug)]
-struct Tally {
-    poses: usize,
-    lost: Vec<String>,
-    factored: usize,
-    extended: usize,
-    unproved: Vec<String>,
-}
-
-fn check_machine(m: &Machine, starts_per_set: usize, seed: u64, t: &mut Tally) {
+/// Runs `check` on the default machine and ten random valid geometries and asserts: enough
+/// poses, none lost, unproved answers rare (at most one per thousand; counted in
+/// docs/reliability.md), and the hard path reached.
+fn across_machines(
+    what: &str,
+    seed: u64,
+    check: impl Fn(&Machine, &mut Sampler) -> Tally,
+    min_poses: u64,
+) -> Tally {
+    let mut machines = vec![Machine::default_verne()];
+    machines.extend(random_geometries(10, seed));
     let mut rng = Sampler::new(seed);
-    for set in HardSet::ALL {
-        let mut built = 0;
-        let mut tries = 0;
-        while built < starts_per_set && tries < 20 * starts_per_set {
-            tries += 1;
-            let Some((p0, b)) = random_start(m, &mut rng) else {
-                continue;
-            };
-            let dir = rng.direction();
-            let poses = construct(m, set, &p0, &dir, &b, 300.0);
-            if poses.is_empty() {
-                continue;
-            }
-            built += 1;
-            for c in poses {
-                t.poses += 1;
-                let modes = module_fk::solve(m, &c.rho);
-                // At a parallel singularity the pose is determined by the sliders only to the
-                // square root of their rounding (two modes meet: about 1e-5 mm), and the line
-                // through P maps to a curve of sliders tangent to the fold, which stays within
-                // rounding of it up to offsets of about 1e-5 mm: there the two modes may be
-                // a pair or none for the rounded sliders, and either is correct when proved.
-                let fold = set == HardSet::ParallelSingularity;
-                let (mm, rad) = if fold {
-                    (FOLD_MATCH_MM, FOLD_MATCH_RAD)
-                } else {
-                    (MATCH_MM, MATCH_RAD)
-                };
-                let found = modes.iter().any(|f| {
-                    (f.pose.p - c.p).amax() < mm && wrap_angle(f.pose.alpha - c.alpha).abs() < rad
-                }) || (fold
-                    && c.offset_mm.abs() <= FOLD_ROUNDING_OFFSET_MM
-                    && modes.certificate.proved());
-                let what = format!(
-                    "{} {:?} offset {:e}: rho = ({:?}, {:?}, {:?}), P = {:?}, alpha = {:?}",
-                    m.name, set, c.offset_mm, c.rho.x, c.rho.y, c.rho.z, c.p, c.alpha
-                );
-                if !found {
-                    t.lost.push(what.clone());
-                }
-                match modes.certificate {
-                    Certificate::Double => {}
-                    Certificate::Factored => t.factored += 1,
-                    Certificate::Extended => t.extended += 1,
-                    _ => t.unproved.push(what),
-                }
-            }
-        }
+    let mut t = Tally::default();
+    for m in &machines {
+        t.add(check(m, &mut rng));
     }
+    eprintln!(
+        "{what}: {} poses, {} lost, {} factored, {} extended, {} unproved",
+        t.poses, t.lost, t.factored, t.extended, t.unproved
+    );
+    assert!(t.poses >= min_poses, "{what}: only {} poses", t.poses);
+    assert!(t.lost == 0, "{what}: lost\n{}", t.examples.join("\n"));
+    assert!(
+        t.unproved * 1000 <= t.poses,
+        "{what}: unproved {}\n{}",
+        t.unproved,
+        t.examples.join("\n")
+    );
+    t
 }
 
 #[test]
 fn fk_of_constructed_hard_poses_contains_them() {
-    let mut t = Tally::default();
-    check_machine(&Machine::default_verne(), 6, 1, &mut t);
-    for (k, m) in random_geometries(10, 2024).iter().enumerate() {
-        check_machine(m, 3, 100 + k as u64, &mut t);
-    }
-    eprintln!(
-        "{} constructed poses: {} lost, {} factored, {} extended, {} unproved",
-        t.poses,
-        t.lost.len(),
-        t.factored,
-        t.extended,
-        t.unproved.len()
+    let t = across_machines(
+        "module FK",
+        2024,
+        |m, rng| {
+            let mut t = Tally::default();
+            for set in HardSet::ALL {
+                t.add(check_fk(m, set, 3, rng));
+            }
+            t
+        },
+        2000,
     );
-    assert!(t.poses > 2000, "only {} poses", t.poses);
-    assert!(t.lost.is_empty(), "lost modes:\n{}", t.lost.join("\n"));
-    // Unproved rows must be rare (and are counted in docs/reliability.md).
-    assert!(
-        t.unproved.len() * 1000 <= t.poses,
-        "unproved: {}\n{}",
-        t.unproved.len(),
-        t.unproved
-            .iter()
-            .take(10)
-            .cloned()
-            .collect::<Vec<_>>()
-            .join("\n")
+    assert!(t.factored + t.extended > t.poses / 20);
+}
+
+/// The machine's inverse kinematics on tool poses built on Table II's double root
+/// ([`check_machine_ik`]).
+#[test]
+fn machine_ik_of_constructed_table_ii_poses_contains_the_joints() {
+    let t = across_machines("machine IK", 77, |m, rng| check_machine_ik(m, 8, rng), 1000);
+    // The construction reaches the hard path: the double root at alpha = 0 is on every pose
+    // built at offset 0.
+    assert!(t.factored + t.extended > t.poses / 20);
+}
+
+/// The module's inverse kinematics on points built on the degenerate sets from the slider side
+/// ([`check_ik`]), the cubic (9)'s double root among them.
+#[test]
+fn ik_of_constructed_hard_points_contains_the_sliders() {
+    let t = across_machines(
+        "module IK",
+        99,
+        |m, rng| {
+            let mut t = Tally::default();
+            for set in HardSet::ALL {
+                t.add(check_ik(m, set, 3, rng));
+            }
+            t
+        },
+        1000,
     );
+    assert!(t.factored + t.extended > 0);
 }
 
 /// The examples of the issue: Table III's neighbourhood on the default machine, and the L2 = L3
@@ -140,161 +118,145 @@ fn the_reported_triples_give_every_mode() {
     }
 }
 
-/// The machine's inverse kinematics on tool poses whose theta1 equation (15) has its double root
-/// (Table II of IFToMM 2007 along the pose: at the theta1 where alpha = 0 the platform point has
-/// y_p = 0, and rho1 - z_p takes both signs), and next to it: the platform point P = (x, offset,
-/// z) with a module branch at alpha near 0, any theta1 and theta2, the tool pose from eq. (26) of
-/// AIM 2007. The machine IK of that pose must contain the joints, with a proved certificate.
+/// The issue's 11-row path, 0.002 mm steps of rho2 across the thin set of the default machine:
+/// `verne fk` gives the working mode on every row (tracked or solved), and `verne verify` of the
+/// machine joints against the tool poses `verne fk` computes for them is clean (no false
+/// `branch` finding).
 #[test]
-fn machine_ik_of_constructed_table_ii_poses_contains_the_joints() {
-    use verne::machine_kin::{machine_ik, tool_pose_eq26};
-    use verne::module_geometry::ModulePose;
-    use verne::module_ik;
-    let mut machines = vec![Machine::default_verne()];
-    machines.extend(random_geometries(10, 77));
-    let (mut poses, mut lost, mut unproved) = (0usize, Vec::new(), Vec::new());
-    let (mut factored, mut extended) = (0usize, 0usize);
-    let mut rng = Sampler::new(5);
-    for m in &machines {
-        let mut built = 0;
-        for _ in 0..400 {
-            if built >= 8 {
-                break;
-            }
-            let Some((p0, _)) = random_start(m, &mut rng) else {
-                continue;
-            };
-            let (theta1, theta2) = (
-                rng.uniform(m.limits.theta1_min, m.limits.theta1_max),
-                rng.uniform(-3.0, 3.0),
-            );
-            let mut any = false;
-            for off in verne::hard_sets::OFFSETS_MM {
-                let p = nalgebra::Vector3::new(p0.x, off, p0.z);
-                for b in module_ik::solve(m, &p) {
-                    if b.alpha.abs() > 0.1 {
-                        continue;
-                    }
-                    any = true;
-                    poses += 1;
-                    let module = ModulePose { p, alpha: b.alpha };
-                    let tool = tool_pose_eq26(&m.table, &module, theta1, theta2, m.tool_length);
-                    let ik = machine_ik(m, &tool, m.tool_length);
-                    let found = ik.iter().any(|x| {
-                        (x.rho - b.rho).amax() < MATCH_MM
-                            && wrap_angle(x.theta1 - theta1).abs() < MATCH_RAD
-                    });
-                    let what = format!(
-                        "{}: P = {p:?}, alpha = {:?}, rho = {:?}, theta1 = {theta1:?}, theta2 = {theta2:?}",
-                        m.name, b.alpha, b.rho
-                    );
-                    if !found {
-                        lost.push(what.clone());
-                    }
-                    match ik.certificate {
-                        Certificate::Double => {}
-                        Certificate::Factored => factored += 1,
-                        Certificate::Extended => extended += 1,
-                        _ => unproved.push(what),
-                    }
-                }
-            }
-            built += usize::from(any);
-        }
+fn a_path_across_the_thin_set_is_ok_in_fk_and_verify() {
+    let rows: Vec<[f64; 3]> = (-5..=5)
+        .map(|k| {
+            [
+                923.8484370198487,
+                967.2529090413111 + 0.002 * k as f64,
+                876.4439649983864,
+            ]
+        })
+        .collect();
+    let module: String = std::iter::once("rho1,rho2,rho3\n".to_string())
+        .chain(
+            rows.iter()
+                .map(|r| format!("{:?},{:?},{:?}\n", r[0], r[1], r[2])),
+        )
+        .collect();
+    let out = common::run(&["fk"], Some(&module));
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (h, cells) = common::table_of(&out);
+    let status = common::col(&h, "status");
+    assert_eq!(cells.len(), 11);
+    assert!(cells.iter().all(|r| r[status] == "ok"), "{cells:?}");
+    // The library's tracker along the same rows: the working mode on every row.
+    let m = Machine::default_verne();
+    let mut tracker = verne::fk_track::FkTracker::new(&m);
+    let mut modes = module_fk::FkModes::new();
+    for r in &rows {
+        tracker.working_into(&nalgebra::Vector3::new(r[0], r[1], r[2]), &mut modes);
+        assert!(module_fk::working(&modes).is_some(), "{r:?}");
     }
-    eprintln!(
-        "{poses} machine poses: {} lost, {factored} factored, {extended} extended, {} unproved",
-        lost.len(),
-        unproved.len()
+    // Machine joints (theta1 = theta2 = 0), their tool poses, and verify.
+    let dir = std::env::temp_dir().join(format!("verne-thin-set-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let joints: String = std::iter::once("id,t,rho1,rho2,rho3,theta1,theta2\n".to_string())
+        .chain(rows.iter().enumerate().map(|(k, r)| {
+            format!(
+                "{},{},{:?},{:?},{:?},0,0\n",
+                k + 1,
+                0.01 * k as f64,
+                r[0],
+                r[1],
+                r[2]
+            )
+        }))
+        .collect();
+    let jpath = dir.join("joints.csv");
+    std::fs::write(&jpath, &joints).unwrap();
+    let fk = common::run(&["fk", jpath.to_str().unwrap()], None);
+    assert_eq!(fk.status.code(), Some(0));
+    let (h, cells) = common::table_of(&fk);
+    let cols = ["id", "x", "y", "z", "i", "j", "k"].map(|c| common::col(&h, c));
+    let path: String = std::iter::once("id,x,y,z,i,j,k\n".to_string())
+        .chain(cells.iter().map(|r| {
+            let v: Vec<&str> = cols.iter().map(|&c| r[c].as_str()).collect();
+            format!("{}\n", v.join(","))
+        }))
+        .collect();
+    let ppath = dir.join("path.csv");
+    std::fs::write(&ppath, &path).unwrap();
+    let verify = common::run(
+        &[
+            "verify",
+            "--joints",
+            jpath.to_str().unwrap(),
+            "--path",
+            ppath.to_str().unwrap(),
+        ],
+        None,
     );
-    // The construction reaches the hard path: the double root at alpha = 0 is on every pose
-    // built at offset 0.
-    assert!(
-        factored + extended > poses / 20,
-        "{factored} + {extended} of {poses}"
-    );
-    assert!(poses > 300, "only {poses}");
-    assert!(lost.is_empty(), "lost:\n{}", lost.join("\n"));
-    assert!(
-        unproved.len() * 1000 <= poses,
-        "unproved:\n{}",
-        unproved.join("\n")
-    );
+    let text = String::from_utf8_lossy(&verify.stdout).to_string()
+        + &String::from_utf8_lossy(&verify.stderr);
+    assert_eq!(verify.status.code(), Some(0), "{text}");
+    assert!(text.contains("clean"), "{text}");
+    std::fs::remove_dir_all(&dir).ok();
 }
 
-/// The inverse kinematics of the module on points built on the degenerate sets from the other
-/// side: sliders moved along a line while an assembly mode is followed, to the zero of the
-/// vanishing quantity at the mode (the cubic (9)'s double root among them: two leg-I postures
-/// meet). The branches of the mode's point must contain the sliders, with a proved certificate.
+/// `verne selftest` tells the truth: the L2 = L3 machine of the issue passes (its degenerate
+/// sets sampled too), and a machine on which nothing can be assembled within its strokes fails,
+/// saying that nothing was tested.
 #[test]
-fn ik_of_constructed_hard_points_contains_the_sliders() {
-    use verne::hard_sets::{construct_from_sliders, random_slider_start};
-    use verne::module_ik;
-    let mut machines = vec![Machine::default_verne()];
-    machines.extend(random_geometries(10, 99));
-    let (mut poses, mut lost, mut unproved) = (0usize, Vec::new(), Vec::new());
-    let (mut factored, mut extended) = (0usize, 0usize);
-    let mut rng = Sampler::new(11);
-    for m in &machines {
-        for set in HardSet::ALL {
-            let mut built = 0;
-            for _ in 0..60 {
-                if built >= 3 {
-                    break;
-                }
-                let Some((rho0, mode)) = random_slider_start(m, &mut rng) else {
-                    continue;
-                };
-                let dir = rng.direction();
-                let cs = construct_from_sliders(m, set, &rho0, &dir, &mode, 300.0);
-                if cs.is_empty() {
-                    continue;
-                }
-                built += 1;
-                for c in cs {
-                    poses += 1;
-                    let ik = module_ik::solve(m, &c.p);
-                    // A fold of the inverse kinematics (two postures meet) fixes the sliders
-                    // only to the square root of the point's rounding, as a parallel
-                    // singularity fixes the pose (see the forward kinematics' test).
-                    let fold = set == HardSet::Cubic9DoubleRoot;
-                    let (mm, rad) = if fold {
-                        (FOLD_MATCH_MM, FOLD_MATCH_RAD)
-                    } else {
-                        (MATCH_MM, MATCH_RAD)
-                    };
-                    let found = ik.iter().any(|b| {
-                        (b.rho - c.rho).amax() < mm && wrap_angle(b.alpha - c.alpha).abs() < rad
-                    }) || (fold
-                        && c.offset_mm.abs() <= FOLD_ROUNDING_OFFSET_MM
-                        && ik.certificate.proved());
-                    let what = format!(
-                        "{} {:?} offset {:e}: P = {:?}, alpha = {:?}, rho = {:?}",
-                        m.name, set, c.offset_mm, c.p, c.alpha, c.rho
-                    );
-                    if !found {
-                        lost.push(what.clone());
-                    }
-                    match ik.certificate {
-                        Certificate::Double => {}
-                        Certificate::Factored => factored += 1,
-                        Certificate::Extended => extended += 1,
-                        _ => unproved.push(what),
-                    }
-                }
+fn selftest_samples_the_hard_sets_and_fails_when_nothing_is_tested() {
+    let dir = std::env::temp_dir().join(format!("verne-selftest-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let show = common::run(&["machine", "show"], None);
+    let text = String::from_utf8(show.stdout).unwrap();
+    let sym = text
+        .lines()
+        .map(|l| {
+            if l.starts_with("L3 =") {
+                "L3 = 950.30"
+            } else {
+                l
             }
-        }
-    }
-    eprintln!(
-        "{poses} points: {} lost, {factored} factored, {extended} extended, {} unproved",
-        lost.len(),
-        unproved.len()
-    );
-    assert!(poses > 1000, "only {poses}");
-    assert!(lost.is_empty(), "lost:\n{}", lost.join("\n"));
-    assert!(
-        unproved.len() * 1000 <= poses,
-        "unproved:\n{}",
-        unproved.join("\n")
-    );
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    let sym_path = dir.join("sym.toml");
+    std::fs::write(&sym_path, &sym).unwrap();
+    let out = common::run(&["selftest", "-m", sym_path.to_str().unwrap()], None);
+    let report = String::from_utf8_lossy(&out.stdout).to_string();
+    assert_eq!(out.status.code(), Some(0), "{report}");
+    assert!(report.contains("PASS"), "{report}");
+    let line = report
+        .lines()
+        .find(|l| l.starts_with("poses on degenerate sets"))
+        .unwrap();
+    let n: u64 = line.split_whitespace().nth(4).unwrap().parse().unwrap();
+    assert!(n > 100, "{line}");
+    // Slider II 5 m above the others: the rods cannot close, no mode anywhere.
+    let far: Vec<String> = text
+        .lines()
+        .map(|l| match l.split('=').next().map(str::trim) {
+            Some("rho1_min") | Some("rho3_min") => {
+                format!("{} = 0.0", l.split('=').next().unwrap())
+            }
+            Some("rho1_max") | Some("rho3_max") => {
+                format!("{} = 1.0", l.split('=').next().unwrap())
+            }
+            Some("rho2_min") => "rho2_min = 5000.0".to_string(),
+            Some("rho2_max") => "rho2_max = 5001.0".to_string(),
+            _ => l.to_string(),
+        })
+        .collect();
+    let far_path = dir.join("far.toml");
+    std::fs::write(&far_path, far.join("\n")).unwrap();
+    let out = common::run(&["selftest", "-m", far_path.to_str().unwrap()], None);
+    let report =
+        String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{report}");
+    assert!(report.contains("FAIL: no assembly mode"), "{report}");
+    std::fs::remove_dir_all(&dir).ok();
 }

@@ -3,6 +3,7 @@
 
 use nalgebra::Vector3;
 use verne::branches::{Config, Verdict};
+use verne::certificate::Certificate;
 use verne::error::VerneError;
 use verne::jacobian::kinetostatics;
 use verne::machine::Machine;
@@ -89,17 +90,30 @@ pub fn run(args: &ModesArgs) -> Result<u8, VerneError> {
     })
 }
 
+/// What proves the list complete, in words.
+fn proof(c: Certificate) -> &'static str {
+    match c {
+        Certificate::Double => "proved complete in double precision",
+        Certificate::Factored => {
+            "proved complete; close roots separated by the two factors of the equation"
+        }
+        Certificate::Extended => "proved complete; close roots separated in double-double",
+        _ => "NOT proved complete: status uncertified",
+    }
+}
+
 /// Every branch of the query (`--pose`: inverse; `--joints`: forward) and a title line.
 fn query(machine: &Machine, args: &ModesArgs) -> (String, Vec<Solution>) {
     if let Some(p) = args.pose {
         let p = Vector3::new(p[0], p[1], p[2]);
         let b = module_ik::solve(machine, &p);
         let title = format!(
-            "inverse kinematics of P = ({}, {}, {}) mm: {} real branches",
+            "inverse kinematics of P = ({}, {}, {}) mm: {} real branches ({})",
             p.x,
             p.y,
             p.z,
-            b.len()
+            b.len(),
+            proof(b.certificate)
         );
         let s = b
             .iter()
@@ -116,11 +130,12 @@ fn query(machine: &Machine, args: &ModesArgs) -> (String, Vec<Solution>) {
         let rho = Sliders::new(j[0], j[1], j[2]);
         let m = module_fk::solve(machine, &rho);
         let title = format!(
-            "forward kinematics of rho = ({}, {}, {}) mm: {} real assembly modes",
+            "forward kinematics of rho = ({}, {}, {}) mm: {} real assembly modes ({})",
             j[0],
             j[1],
             j[2],
-            m.len()
+            m.len(),
+            proof(m.certificate)
         );
         let s = m
             .iter()
