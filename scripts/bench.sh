@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
-# End-to-end benchmark of `verne ik` and `verne fk` against the I/O floor (src/bin/io_floor.rs),
-# plus the criterion kernels (benches/kernels.rs); writes the figures into docs/benchmarks.md
+# End-to-end benchmark of `verne ik` and `verne fk` against the I/O floor
+# (crates/verne-cli/examples/io_floor.rs), plus the criterion kernels
+# (crates/verne-cli/benches/kernels.rs); writes the figures into docs/benchmarks.md
 # between the `bench.sh:begin` / `bench.sh:end` markers (the text around them is kept).
 #
 # Usage: scripts/bench.sh [--rows N] [--big] [--runs N] [--no-kernels] [--no-docs]
 #   --rows N      rows of the timing trajectory (default 1000000; the tool-pose path has N / 10)
 #   --big         also run the 10,000,000-row memory check (peak RSS of verne ik and fk)
 #   --runs N      timed runs per command (default 5)
-#   --no-kernels  skip `cargo bench --bench kernels`
+#   --no-kernels  skip `cargo bench -p verne-cli --bench kernels`
 #   --no-docs     print the figures, leave docs/benchmarks.md alone
 #
 # Timing uses hyperfine (installed with apt-get when missing and possible), else /usr/bin/time
@@ -28,7 +29,7 @@ while [ $# -gt 0 ]; do
         --runs) RUNS="$2"; shift 2 ;;
         --no-kernels) KERNELS=0; shift ;;
         --no-docs) DOCS=0; shift ;;
-        -h|--help) sed -n '2,14p' "$0"; exit 0 ;;
+        -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
         *) echo "bench.sh: unknown argument $1" >&2; exit 2 ;;
     esac
 done
@@ -54,10 +55,10 @@ HYPERFINE=$(command -v hyperfine || true)
 TARGET_DIR=${CARGO_TARGET_DIR:-target}
 WORK="$TARGET_DIR/bench-data"
 mkdir -p "$WORK"
-log "building release binaries"
-cargo build --release --bins 2>&1 | tail -1 >&2
+log "building the release binary and the I/O floor"
+cargo build --release -p verne-cli --bin verne --example io_floor 2>&1 | tail -1 >&2
 VERNE="$TARGET_DIR/release/verne"
-FLOOR="$TARGET_DIR/release/io_floor"
+FLOOR="$TARGET_DIR/release/examples/io_floor"
 
 # The trajectory: the kernels' helix (radius 120 mm around (-250, 0), 4096 rows per turn, about
 # 0.2 mm per row) rising from z = 1000 to 1300 mm over the file.
@@ -72,8 +73,8 @@ gen_path() { # rows file
 }
 
 # The CAM job's input: tool poses (tip + axis in the workpiece frame) on the kernels' dome spiral
-# (benches/kernels.rs: centre (0, 0, -100), radius 150 mm, tool tilted 6 to 30 deg along the
-# normal, tips 0.5 mm apart), tips with 4 decimals and axes with 7.
+# (crates/verne-cli/benches/kernels.rs: centre (0, 0, -100), radius 150 mm, tool tilted 6 to
+# 30 deg along the normal, tips 0.5 mm apart), tips with 4 decimals and axes with 7.
 gen_tool_path() { # rows file
     awk -v n="$1" 'BEGIN {
         print "x,y,z,i,j,k"; pi = 3.141592653589793; r = 150; step = 0.5
@@ -162,8 +163,8 @@ fi
 
 KERNEL_TABLE=""
 if [ "$KERNELS" = 1 ]; then
-    log "cargo bench --bench kernels (a few minutes)"
-    VERNE_BENCH_SUMMARY="$WORK/kernels.md" cargo bench --bench kernels >"$WORK/kernels.log" 2>&1
+    log "cargo bench -p verne-cli --bench kernels (a few minutes)"
+    VERNE_BENCH_SUMMARY="$WORK/kernels.md" cargo bench -p verne-cli --bench kernels >"$WORK/kernels.log" 2>&1
     KERNEL_TABLE=$(cat "$WORK/kernels.md")
 fi
 
@@ -215,7 +216,7 @@ REPORT="$WORK/report.md"
     echo "Commands (\`scripts/bench.sh\` runs them):"
     echo
     echo '```sh'
-    echo "cargo build --release --bins"
+    echo "cargo build --release -p verne-cli --bin verne --example io_floor"
     echo "$VERNE ik $PATH_CSV -o $OUT"
     echo "RAYON_NUM_THREADS=1 $VERNE ik $PATH_CSV -o $OUT"
     echo "$FLOOR ik $PATH_CSV -o $OUT"
@@ -227,11 +228,11 @@ REPORT="$WORK/report.md"
     echo "RAYON_NUM_THREADS=1 $VERNE ik $TOOL_CSV -o $OUT"
     [ -n "$BIG_IK" ] && echo "/usr/bin/time -v $VERNE ik $WORK/path_$BIG_ROWS.csv -o $WORK/joints_$BIG_ROWS.csv"
     [ -n "$BIG_IK" ] && echo "/usr/bin/time -v $VERNE fk $WORK/joints_$BIG_ROWS.csv > /dev/null"
-    [ -n "$KERNEL_TABLE" ] && echo "VERNE_BENCH_SUMMARY=$WORK/kernels.md cargo bench --bench kernels"
+    [ -n "$KERNEL_TABLE" ] && echo "VERNE_BENCH_SUMMARY=$WORK/kernels.md cargo bench -p verne-cli --bench kernels"
     echo '```'
     if [ -n "$KERNEL_TABLE" ]; then
         echo
-        echo "Kernels (\`cargo bench --bench kernels\`; medians of criterion's samples, ns per pose; every ratio is measured in the same run):"
+        echo "Kernels (\`cargo bench -p verne-cli --bench kernels\`; medians of criterion's samples, ns per pose; every ratio is measured in the same run):"
         echo
         echo "$KERNEL_TABLE"
     fi

@@ -1,8 +1,8 @@
 #![no_main]
-//! Fuzz target: see verne::fuzz_entry.
+//! Fuzz target: see verne_cli::fuzz_entry.
 
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    verne::fuzz_entry::arg_values(data);
+    verne_cli::fuzz_entry::arg_values(data);
 });

@@ -1,0 +1,339 @@
+//! Command-line definitions (clap derive). The `///` comments are the help text, written for
+//! the terminal (`[verify]`, `<length>`), not for rustdoc.
+#![allow(rustdoc::broken_intra_doc_links, rustdoc::invalid_html_tags)]
+
+use std::path::PathBuf;
+
+use clap::{Args, Parser, Subcommand};
+
+const EXIT_CODES: &str = "\
+Exit codes:
+  0  success: every row ok (every check passed)
+  1  the run finished, but some row is not ok (or a check failed)
+  2  fatal: bad arguments, unreadable or malformed input or machine file";
+
+/// Exact kinematics of the VERNE 5-axis parallel kinematic machine tool (and planar glider
+/// mechanisms): joint tables from toolpaths, every inverse and forward branch, workspaces.
+#[derive(Debug, Parser)]
+#[command(name = "verne", version, after_help = EXIT_CODES, max_term_width = 100)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Inverse kinematics: platform points (xp,yp,zp) -> joints (alpha, rho1, rho2, rho3).
+    #[command(
+        after_help = "Example:\n  verne ik data/path.csv -o joints.csv\n  verne ik --all --radians --pose=-240,-86,1000\n\nInput columns: xp,yp,zp (mm). Output adds alpha,rho1,rho2,rho3,status\n(--all: branch,alpha,rho1,rho2,rho3,s1,s2,s3,working,status).\n\nExit codes: 0 all rows ok, 1 some row not ok, 2 fatal."
+    )]
+    Ik(IkArgs),
+    /// Forward kinematics: joints (rho1,rho2,rho3) -> platform pose (xp, yp, zp, alpha).
+    #[command(
+        after_help = "Example:\n  verne fk joints.csv\n  verne fk --all --radians --joints 674,685,250\n  verne ik path.csv | verne fk\n\nInput columns: rho1,rho2,rho3 (mm). Output adds xp,yp,zp,alpha,status\n(--all: branch,xp,yp,zp,alpha,s1,s2,s3,working,status).\n\nExit codes: 0 all rows ok, 1 some row not ok, 2 fatal."
+    )]
+    Fk(FkArgs),
+    /// Every branch of one query, with its verdict, as a table for a person (or --csv).
+    #[command(
+        after_help = "Example:\n  verne modes --joints 674,685,250\n  verne modes --pose=-240,-86,1000 --csv"
+    )]
+    Modes(ModesArgs),
+    /// Compare the glider architectures (Wenger 2001): Tables 1 and 2, paper beside computed.
+    #[command(
+        after_help = "Example:\n  verne design\n  verne design --l 1000 --csv\n  verne design --bounds 1/2,2\n\nTable 1: L0, delta-rho per strut length L and S (largest rectangle) per L^2.\nTable 2: dimensions (m) and envelope (m^2) for a 1 m^2 rectangle, then a square.\n--csv columns: table,mechanism,target,quantity,unit,computed,paper,rel_diff.\n\nExit codes: 0 every mechanism designed, 1 some cannot meet the bounds, 2 fatal."
+    )]
+    Design(DesignArgs),
+    /// Show the default machine file, or check one.
+    #[command(subcommand)]
+    Machine(MachineCommand),
+    /// Workspace on a grid: platform point, tool tip (eq. (27)) or manufacturing workspace
+    /// (eq. (26)), constraints (i)-(v) reported separately; volume, bounding box, largest box.
+    #[command(
+        after_help = "Example:\n  verne workspace --step 10\n  verne workspace --of tool --tool-length 0,50,100,150 --step 10\n  verne workspace --of manufacturing --step 10 -o points.csv --plot ws.svg --slice z=-50\n\nA point is inside when a branch with s=(-1,-1,-1) satisfies every constraint; otherwise its\n`status` is the binding constraint (the reference branch's first failure in the order\nrods_cross, rod_tilt, singularity, stroke, theta1_range) or out_of_reach.\nOutput columns (-o): tool_length,x,y,z,xp,yp,zp,alpha,rho1,rho2,rho3,lambda1,lambda2,lambda3,status,fails.\n\nExit codes: 0 ok, 1 some workspace is empty, 2 fatal."
+    )]
+    Workspace(WorkspaceArgs),
+    /// Round-trip self-test of a machine file over a grid of joints: reports the worst residual.
+    #[command(
+        after_help = "Example:\n  verne selftest -m my_machine.toml --grid 16\n\nExit codes: 0 every round trip returned, 1 some did not, 2 fatal."
+    )]
+    Selftest(SelftestArgs),
+    /// Check a postprocessor's joint table against the intended tool path: tip and axis errors,
+    /// limits (also mid-segment), chordal error, branch flips, singularity proximity, joint jumps,
+    /// speeds and accelerations. One report row per violation.
+    #[command(after_help = crate::report::verify::help_text())]
+    Verify(VerifyArgs),
+    /// Print a shell completion script.
+    #[command(
+        after_help = "Example:\n  verne completions bash > ~/.local/share/bash-completion/completions/verne"
+    )]
+    Completions {
+        /// The shell.
+        shell: clap_complete::Shell,
+    },
+    /// Print the man page (roff), as kept in docs/verne.1.
+    #[command(hide = true)]
+    Manpage,
+}
+
+/// Options shared by the row commands.
+#[derive(Debug, Args)]
+pub struct CommonArgs {
+    /// Machine file (TOML, or CSV with a `key,value` header). Default: the embedded VERNE machine.
+    #[arg(short = 'm', long = "machine", value_name = "FILE")]
+    pub machine: Option<PathBuf>,
+    /// Angles in radians instead of degrees (input and output).
+    #[arg(long)]
+    pub radians: bool,
+    /// Write numbers with this many decimals (default: shortest exact form).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u8).range(0..=17))]
+    pub precision: Option<u8>,
+}
+
+#[derive(Debug, Args)]
+pub struct IkArgs {
+    /// Input: a CSV of tool poses (x,y,z with i,j,k or phi1,phi2; workpiece frame), a CSV of
+    /// platform points (xp,yp,zp), or an APT CL file (.cl/.apt); absent or `-` reads stdin.
+    #[arg(value_name = "INPUT")]
+    pub input: Option<PathBuf>,
+    /// How to read INPUT (default: `apt` for a .cl or .apt file, else `csv`).
+    #[arg(long, value_enum, value_name = "FORMAT")]
+    pub input_format: Option<InputFormat>,
+    /// One platform point XP,YP,ZP instead of an input file (repeatable). Use
+    /// `--pose=-240,-86,1000` for negative values.
+    #[arg(long, value_name = "XP,YP,ZP", value_parser = parse_triple, conflicts_with_all = ["input", "tool"])]
+    pub pose: Vec<[f64; 3]>,
+    /// One tool pose X,Y,Z,I,J,K (tip in mm and tool axis, workpiece frame) instead of an input
+    /// file (repeatable; rows of one path).
+    #[arg(long, value_name = "X,Y,Z,I,J,K", value_parser = parse_tool_pose, conflicts_with = "input", allow_hyphen_values = true)]
+    pub tool: Vec<[f64; 6]>,
+    /// Tool length Delta (mm), overriding the machine file's.
+    #[arg(long, value_name = "MM", value_parser = parse_positive)]
+    pub tool_length: Option<f64>,
+    /// On the first row of a path, which orientation solution to take when both are feasible.
+    #[arg(long, value_enum, default_value = "smallest-theta1")]
+    pub prefer: Prefer,
+    /// Output format: CSV, or a space-separated joint list for LinuxCNC's halstreamer.
+    #[arg(long, value_enum, default_value = "csv")]
+    pub format: OutputFormat,
+    /// Output CSV (written atomically); absent or `-` writes stdout.
+    #[arg(short = 'o', long = "output", value_name = "FILE")]
+    pub output: Option<PathBuf>,
+    /// Every real branch, one row each, instead of the machine's working branch.
+    #[arg(long)]
+    pub all: bool,
+    #[command(flatten)]
+    pub common: CommonArgs,
+}
+
+#[derive(Debug, Args)]
+pub struct FkArgs {
+    /// Input CSV with columns rho1,rho2,rho3 (mm), and theta1,theta2 (the table) for the whole
+    /// machine; absent or `-` reads stdin.
+    #[arg(value_name = "INPUT")]
+    pub input: Option<PathBuf>,
+    /// One set of slider positions R1,R2,R3 instead of an input file (repeatable).
+    #[arg(long, value_name = "R1,R2,R3", value_parser = parse_triple, conflicts_with_all = ["input", "machine_joints"])]
+    pub joints: Vec<[f64; 3]>,
+    /// One set of machine joints RHO1,RHO2,RHO3,THETA1,THETA2 instead of an input file
+    /// (repeatable).
+    #[arg(long, value_name = "R1,R2,R3,T1,T2", value_parser = parse_machine_joints, conflicts_with = "input", allow_hyphen_values = true)]
+    pub machine_joints: Vec<[f64; 5]>,
+    /// Tool length Delta (mm), overriding the machine file's.
+    #[arg(long, value_name = "MM", value_parser = parse_positive)]
+    pub tool_length: Option<f64>,
+    /// Output CSV (written atomically); absent or `-` writes stdout.
+    #[arg(short = 'o', long = "output", value_name = "FILE")]
+    pub output: Option<PathBuf>,
+    /// Every real assembly mode, one row each, instead of the machine's working mode.
+    #[arg(long)]
+    pub all: bool,
+    #[command(flatten)]
+    pub common: CommonArgs,
+}
+
+#[derive(Debug, Args)]
+pub struct ModesArgs {
+    /// A platform point XP,YP,ZP: every inverse branch.
+    #[arg(long, value_name = "XP,YP,ZP", value_parser = parse_triple, required_unless_present = "joints", conflicts_with = "joints")]
+    pub pose: Option<[f64; 3]>,
+    /// Slider positions R1,R2,R3: every assembly mode.
+    #[arg(long, value_name = "R1,R2,R3", value_parser = parse_triple)]
+    pub joints: Option<[f64; 3]>,
+    /// CSV for a script instead of an aligned table.
+    #[arg(long)]
+    pub csv: bool,
+    /// Also draw every branch (sliders, rods, platform; front view) to FILE.svg or FILE.png.
+    #[arg(long, value_name = "FILE.svg|png")]
+    pub plot: Option<PathBuf>,
+    #[command(flatten)]
+    pub common: CommonArgs,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum MachineCommand {
+    /// Print the default machine file (a template to edit).
+    Show,
+    /// Validate a machine file and report every problem.
+    Check {
+        /// The machine file (TOML or key,value CSV).
+        file: PathBuf,
+    },
+}
+
+pub use crate::arg_values::*;
+
+/// How `verne ik` reads its input.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum InputFormat {
+    Csv,
+    Apt,
+}
+
+/// First-row orientation choice along a path.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Prefer {
+    /// The working branch with the smallest |theta1|.
+    SmallestTheta1,
+    /// Orientation solution 1: (phi1 >= 0, phi2).
+    Orientation1,
+    /// Orientation solution 2: (-phi1, phi2 + 180).
+    Orientation2,
+}
+
+/// Output format of `verne ik`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum OutputFormat {
+    Csv,
+    /// rho1 rho2 rho3 theta1 theta2 per line, no header (LinuxCNC halstreamer).
+    Halstreamer,
+}
+
+#[derive(Debug, Args)]
+pub struct SelftestArgs {
+    /// Machine file (default: the embedded VERNE machine).
+    #[arg(short = 'm', long = "machine", value_name = "FILE")]
+    pub machine: Option<PathBuf>,
+    /// Grid points per slider axis (the grid spans the strokes: N^3 joint sets).
+    #[arg(long, value_name = "N", default_value_t = 12, value_parser = clap::value_parser!(u16).range(2..=200))]
+    pub grid: u16,
+}
+
+/// Which point's workspace `verne workspace` samples.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum WorkspaceOf {
+    /// The platform point P (base frame, z down).
+    Platform,
+    /// The tool tip, eq. (27) (base frame).
+    Tool,
+    /// The tool tip in the table frame, the table following the platform (theta1 = alpha).
+    Manufacturing,
+}
+
+#[derive(Debug, Args)]
+pub struct WorkspaceArgs {
+    /// Which workspace. Default: platform, or tool when --tool-length is given.
+    #[arg(long, value_enum)]
+    pub of: Option<WorkspaceOf>,
+    /// Tool length(s) in mm, comma-separated: one workspace each, and a table of volume
+    /// against tool length. Default: the machine file's.
+    #[arg(
+        long = "tool-length",
+        value_name = "MM[,MM...]",
+        value_delimiter = ',',
+        allow_negative_numbers = true
+    )]
+    pub tool_length: Vec<f64>,
+    /// Grid step (mm), the same along x, y and z [default: 10 mm; for a glider, 801 nodes along
+    /// the longer side].
+    #[arg(long, value_name = "MM")]
+    pub step: Option<f64>,
+    /// Box sampled (mm, in the workspace's frame). Default: derived from the machine's rod
+    /// lengths, rod-tilt limit and strokes (docs/workspace.md).
+    #[arg(long, value_name = "XMIN,XMAX,YMIN,YMAX,ZMIN,ZMAX", value_parser = parse_bounds, allow_hyphen_values = true)]
+    pub bounds: Option<[f64; 6]>,
+    /// Bounds on the velocity amplification factors, constraint (iii). Default: 1/3,3.
+    #[arg(long, value_name = "LO,HI", value_parser = parse_pair, allow_hyphen_values = true)]
+    pub lambda: Option<[f64; 2]>,
+    /// Grid points CSV (written atomically; `-` writes stdout and moves the summary to stderr).
+    #[arg(short = 'o', long = "output", value_name = "POINTS.csv")]
+    pub output: Option<PathBuf>,
+    /// Write only the inside points to the CSV.
+    #[arg(long, requires = "output")]
+    pub inside_only: bool,
+    /// Picture of slices and projections, coloured by binding constraint (.svg or .png). With
+    /// several tool lengths, one file each, named FILE-L<length>.svg.
+    #[arg(long, value_name = "FILE.svg|png")]
+    pub plot: Option<PathBuf>,
+    /// A slice of the picture (repeatable): z=VALUE (horizontal), or x=VALUE, y=VALUE. Default:
+    /// three horizontal slices across the workspace.
+    #[arg(long, value_name = "z=VALUE", value_parser = parse_slice, requires = "plot", allow_hyphen_values = true)]
+    pub slice: Vec<(usize, f64)>,
+    #[command(flatten)]
+    pub common: CommonArgs,
+}
+
+#[derive(Debug, Args)]
+pub struct DesignArgs {
+    /// Strut length L in mm: Table 1 also gives L0, delta-rho (mm) and S (mm^2).
+    #[arg(long = "l", value_name = "MM", value_parser = parse_positive)]
+    pub l: Option<f64>,
+    /// Bounds LO,HI on both velocity amplification factors, eq. (4); fractions like 1/3 allowed.
+    /// The paper's values are shown only for the paper's bounds 1/3,3.
+    #[arg(long, value_name = "LO,HI", value_parser = parse_lambda_bounds, default_value = "1/3,3")]
+    pub bounds: [f64; 2],
+    /// Workspace grid nodes along the longer side, for S (more: slower, S closer from below).
+    #[arg(long, value_name = "N", default_value_t = 1201, value_parser = clap::value_parser!(u32).range(11..=8001))]
+    pub nodes: u32,
+    /// CSV for a script (one row per quantity) instead of aligned tables.
+    #[arg(long)]
+    pub csv: bool,
+}
+
+/// How `verne verify` prints its summary.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum VerifyFormat {
+    /// Aligned text on stderr.
+    Text,
+    /// One JSON object on stdout (the text summary still goes to stderr).
+    Json,
+}
+
+#[derive(Debug, Args)]
+pub struct VerifyArgs {
+    /// Joint table (CSV): rho1,rho2,rho3 (mm), theta1,theta2 (degrees); optional id, t (s) or
+    /// feed (mm/min).
+    #[arg(long, value_name = "POST.csv")]
+    pub joints: PathBuf,
+    /// Intended path: CSV with x,y,z and i,j,k or phi1,phi2 (degrees), optional id; or an APT CL
+    /// file (.cl, .apt, .cls).
+    #[arg(long, value_name = "INTENDED.csv|cl")]
+    pub path: PathBuf,
+    /// Machine file (TOML, or CSV with a `key,value` header); its [verify] table sets thresholds.
+    /// Default: the embedded VERNE machine.
+    #[arg(short = 'm', long = "machine", value_name = "FILE")]
+    pub machine: Option<PathBuf>,
+    /// Report CSV, one row per violation: row,check,value,limit,detail (written atomically).
+    #[arg(long, value_name = "REPORT.csv")]
+    pub report: Option<PathBuf>,
+    /// Summary format.
+    #[arg(long, value_enum, default_value = "text")]
+    pub format: VerifyFormat,
+    /// Tool length (mm). Default: the machine file's.
+    #[arg(long = "tool-length", value_name = "MM", value_parser = crate::arg_values::parse_positive)]
+    pub tool_length: Option<f64>,
+    /// A threshold NAME=VALUE (repeatable; overrides the machine file's [verify] table). Names
+    /// and defaults are listed below.
+    #[arg(long, value_name = "NAME=VALUE", value_parser = crate::arg_values::parse_threshold)]
+    pub threshold: Vec<(String, f64)>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    #[test]
+    fn cli_definition_is_consistent() {
+        Cli::command().debug_assert();
+    }
+}

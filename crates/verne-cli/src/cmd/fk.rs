@@ -1,0 +1,60 @@
+//! `verne fk`: machine joints -> tool pose in the workpiece frame, or slider positions -> platform
+//! pose of the parallel module (IFToMM 2007, section VI).
+
+use crate::engine::machine_rows::{MachineFkAll, MachineFkWorking};
+use crate::engine::module_rows::{ModuleFkAll, ModuleFkWorking};
+use crate::error::VerneError;
+use crate::table::CsvSource;
+
+use super::{inline_source, load_machine, run_rows, units};
+use crate::cli::FkArgs;
+
+pub fn run(args: &FkArgs) -> Result<u8, VerneError> {
+    if let Some(spec) = super::glider::load(args.common.machine.as_deref())? {
+        return super::glider::fk(args, spec);
+    }
+    let machine = load_machine(args.common.machine.as_deref())?;
+    let u = units(&args.common);
+    let source = if !args.joints.is_empty() {
+        inline_source(
+            "rho1,rho2,rho3",
+            &args.joints.iter().map(|j| j.to_vec()).collect::<Vec<_>>(),
+        )?
+    } else if !args.machine_joints.is_empty() {
+        inline_source(
+            "rho1,rho2,rho3,theta1,theta2",
+            &args
+                .machine_joints
+                .iter()
+                .map(|j| j.to_vec())
+                .collect::<Vec<_>>(),
+        )?
+    } else {
+        CsvSource::open(args.input.as_deref())?
+    };
+    let table = source.column("theta1").is_some() || source.column("theta2").is_some();
+    if table {
+        let tool_length = args.tool_length.unwrap_or(machine.tool_length);
+        let output = args.output.as_ref();
+        if args.all {
+            let mut job = MachineFkAll {
+                machine,
+                tool_length,
+            };
+            run_rows("fk", &mut job, source, output, u)
+        } else {
+            let mut job = MachineFkWorking {
+                machine,
+                tool_length,
+            };
+            run_rows("fk", &mut job, source, output, u)
+        }
+    } else {
+        let output = args.output.as_ref();
+        if args.all {
+            run_rows("fk", &mut ModuleFkAll { machine }, source, output, u)
+        } else {
+            run_rows("fk", &mut ModuleFkWorking { machine }, source, output, u)
+        }
+    }
+}

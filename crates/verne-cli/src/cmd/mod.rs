@@ -1,0 +1,151 @@
+//! One file per subcommand; this file holds what they share: loading the machine, opening the
+//! input and output, and turning a run's summary into an exit code.
+
+pub mod design;
+pub mod fk;
+pub mod glider;
+pub mod ik;
+pub mod machine;
+pub mod modes;
+pub mod selftest;
+pub mod shell;
+pub mod verify;
+pub mod workspace;
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use crate::engine::pipeline::{self, RowJob, RunSummary, Units};
+use crate::error::VerneError;
+use crate::table::{CsvSource, Sink};
+use verne::spec::Machine;
+
+use crate::cli::CommonArgs;
+
+/// The exit-code contract (README, `--help`).
+pub const EXIT_OK: u8 = 0;
+pub const EXIT_ROWS_FAILED: u8 = 1;
+pub const EXIT_FATAL: u8 = 2;
+
+/// Loads `-m FILE`, or the embedded VERNE machine.
+pub fn load_machine(path: Option<&Path>) -> Result<Machine, VerneError> {
+    match path {
+        None => Ok(Machine::default_verne()),
+        Some(p) if !p.exists() && p.as_os_str() == "verne" => Ok(Machine::default_verne()),
+        Some(p) => {
+            let name = p.display().to_string();
+            let text = std::fs::read(p).map_err(|e| VerneError::io(&name, e))?;
+            let text = String::from_utf8(text).map_err(|e| {
+                let upto = &e.as_bytes()[..e.utf8_error().valid_up_to()];
+                let line = upto.iter().filter(|&&b| b == b'\n').count() as u64 + 1;
+                VerneError::input(
+                    &name,
+                    Some(line),
+                    None,
+                    "not UTF-8 text; expected a TOML or key,value CSV machine file",
+                )
+            })?;
+            Ok(Machine::from_str_auto(&text, &name)?)
+        }
+    }
+}
+
+pub fn units(common: &CommonArgs) -> Units {
+    Units {
+        radians: common.radians,
+        decimals: common.precision.map(usize::from),
+        halstreamer: false,
+    }
+}
+
+/// The rows given on the command line as an in-memory CSV with `header`.
+pub fn inline_source(header: &str, rows: &[Vec<f64>]) -> Result<CsvSource, VerneError> {
+    let mut text = format!("{header}\n");
+    for r in rows {
+        let cells: Vec<String> = r.iter().map(f64::to_string).collect();
+        text.push_str(&cells.join(","));
+        text.push('\n');
+    }
+    CsvSource::from_reader(
+        Box::new(std::io::Cursor::new(text.into_bytes())),
+        "<command line>",
+    )
+}
+
+/// Runs a row job from `source` to `output`, with a progress indicator on a terminal, and
+/// prints the summary of rows that were not ok to stderr.
+pub fn run_rows<J: RowJob>(
+    command: &str,
+    job: &mut J,
+    mut source: CsvSource,
+    output: Option<&PathBuf>,
+    units: Units,
+) -> Result<u8, VerneError> {
+    let delimiter = if units.halstreamer { b' ' } else { b',' };
+    let mut sink = Sink::create_delimited(output.map(PathBuf::as_path), delimiter)?;
+    let bar = progress_bar();
+    let tick = |n: u64| {
+        if let Some(b) = &bar {
+            b.set_position(n);
+        }
+    };
+    let result = pipeline::run(job, &mut source, &mut sink, units, &tick);
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let summary = match result {
+        Ok(s) => s,
+        Err(e) => {
+            sink.discard();
+            return Err(e);
+        }
+    };
+    sink.finish()?;
+    report(command, source.name(), &summary);
+    Ok(if summary.all_ok() {
+        EXIT_OK
+    } else {
+        EXIT_ROWS_FAILED
+    })
+}
+
+/// A spinner with the row count and rate, shown only when stderr is a terminal and the run
+/// lasts more than a moment.
+fn progress_bar() -> Option<indicatif::ProgressBar> {
+    if !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let bar = indicatif::ProgressBar::new_spinner();
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{spinner} {pos} rows ({per_sec}) {elapsed}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner()),
+    );
+    bar.enable_steady_tick(Duration::from_millis(200));
+    Some(bar)
+}
+
+fn report(command: &str, file: &str, s: &RunSummary) {
+    if s.all_ok() {
+        return;
+    }
+    let counts: Vec<String> = s.not_ok.iter().map(|(st, n)| format!("{n} {st}")).collect();
+    eprintln!(
+        "verne {command}: {file}: {} of {} rows not ok ({})",
+        s.input_rows - s.ok_rows,
+        s.input_rows,
+        counts.join(", ")
+    );
+    for (line, st) in &s.first_failures {
+        eprintln!("  {file}:{line}: {st}");
+    }
+}
+
+/// Writes text to stdout; a closed pipe surfaces as a broken-pipe error (exit 0), never a panic.
+pub fn write_stdout(text: &str) -> Result<(), VerneError> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    out.write_all(text.as_bytes())
+        .and_then(|_| out.flush())
+        .map_err(|e| VerneError::io("<stdout>", e))
+}

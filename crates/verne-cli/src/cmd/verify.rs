@@ -1,0 +1,86 @@
+//! `verne verify`: a postprocessor's joint table against the intended path (docs/verify.md).
+//! Opens the files, writes the report CSV atomically, prints the summary, picks the exit code.
+
+use crate::error::VerneError;
+use crate::input::verify_files::{JointReader, PathReader};
+use crate::report::verify::{short_number, summary_json, summary_text};
+use crate::table::{CsvSource, Sink};
+use csv::ByteRecord;
+use verne::verify::{Thresholds, VerifyOptions, verify};
+
+use super::{EXIT_OK, EXIT_ROWS_FAILED, load_machine, write_stdout};
+use crate::cli::{VerifyArgs, VerifyFormat};
+
+pub fn run(args: &VerifyArgs) -> Result<u8, VerneError> {
+    let machine = load_machine(args.machine.as_deref())?;
+    let machine_name = args
+        .machine
+        .as_ref()
+        .map(|p| p.display().to_string())
+        .unwrap_or_else(|| "<default>".into());
+    let mut thresholds = Thresholds::from_machine(&machine, &machine_name)?;
+    for (name, value) in &args.threshold {
+        thresholds
+            .set(name, *value)
+            .map_err(|e| VerneError::Usage(format!("--threshold {name}={value}: {e}")))?;
+    }
+    thresholds
+        .check()
+        .map_err(|e| VerneError::Usage(format!("thresholds: {e}")))?;
+    let opt = VerifyOptions {
+        thresholds,
+        tool_length: args.tool_length.unwrap_or(machine.tool_length),
+    };
+    let mut joints = JointReader::new(CsvSource::open(Some(&args.joints))?)?;
+    let mut path = PathReader::open(&args.path)?;
+    let mut sink = match &args.report {
+        Some(p) => {
+            let mut s = Sink::create(Some(p))?;
+            s.write(&ByteRecord::from(vec![
+                "row", "check", "value", "limit", "detail",
+            ]))?;
+            Some(s)
+        }
+        None => None,
+    };
+    let mut rec = ByteRecord::new();
+    let mut write = |v: &verne::verify::Violation| -> Result<(), VerneError> {
+        if let Some(s) = sink.as_mut() {
+            rec.clear();
+            rec.push_field(v.row.as_bytes());
+            rec.push_field(v.check.code().as_bytes());
+            rec.push_field(short_number(v.value).as_bytes());
+            rec.push_field(short_number(v.limit).as_bytes());
+            rec.push_field(v.detail.as_bytes());
+            s.write(&rec)?;
+        }
+        Ok(())
+    };
+    let summary = verify(&machine, &opt, &mut joints, &mut path, &mut write);
+    let summary = match summary {
+        Ok(s) => s,
+        Err(e) => {
+            if let Some(s) = sink.as_mut() {
+                s.discard();
+            }
+            return Err(e);
+        }
+    };
+    if let Some(s) = sink {
+        s.finish()?;
+    }
+    eprint!(
+        "verne verify: {} against {}: {}",
+        args.joints.display(),
+        args.path.display(),
+        summary_text(&summary)
+    );
+    if args.format == VerifyFormat::Json {
+        write_stdout(&format!("{}\n", summary_json(&summary)))?;
+    }
+    Ok(if summary.clean() {
+        EXIT_OK
+    } else {
+        EXIT_ROWS_FAILED
+    })
+}

@@ -1,0 +1,388 @@
+//! `verne workspace`: samples the workspace for each tool length asked, writes the grid points
+//! CSV and the pictures, and prints the summary (stdout, or stderr when the CSV goes to stdout).
+
+use std::fmt::Write as _;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use crate::error::VerneError;
+use crate::plot::{self, View};
+use crate::report::workspace::{POINTS_HEADER, write_point};
+use crate::table::Sink;
+use csv::ByteRecord;
+use nalgebra::Vector3;
+use verne::workspace::{
+    self, Bounds, Constraint, Of, Outcome, PAPER_LAMBDA_BOUNDS, WorkspaceOptions, WorkspaceSummary,
+};
+
+use super::{EXIT_OK, EXIT_ROWS_FAILED, load_machine, units, write_stdout};
+use crate::cli::{WorkspaceArgs, WorkspaceOf};
+
+/// Grid step of the VERNE workspace when `--step` is not given (mm).
+const DEFAULT_STEP_MM: f64 = 10.0;
+
+pub fn run(args: &WorkspaceArgs) -> Result<u8, VerneError> {
+    if let Some(spec) = super::glider::load(args.common.machine.as_deref())? {
+        return super::glider::workspace(
+            &spec,
+            args.step,
+            None,
+            Some(args.lambda.unwrap_or(PAPER_LAMBDA_BOUNDS)),
+            args.output.as_deref(),
+            args.plot.as_deref(),
+            units(&args.common),
+        );
+    }
+    let machine = load_machine(args.common.machine.as_deref())?;
+    let step = args.step.unwrap_or(DEFAULT_STEP_MM);
+    let u = units(&args.common);
+    let of = match args.of {
+        Some(WorkspaceOf::Platform) => Of::Platform,
+        Some(WorkspaceOf::Tool) => Of::Tool,
+        Some(WorkspaceOf::Manufacturing) => Of::Manufacturing,
+        None if !args.tool_length.is_empty() => Of::Tool,
+        None => Of::Platform,
+    };
+    if of == Of::Platform && !args.tool_length.is_empty() {
+        return Err(VerneError::Usage(
+            "--tool-length applies to --of tool or --of manufacturing, not to the platform".into(),
+        ));
+    }
+    let lengths: Vec<f64> = match of {
+        Of::Platform => vec![0.0],
+        _ if args.tool_length.is_empty() => vec![machine.tool_length],
+        _ => args.tool_length.clone(),
+    };
+    if let Some(bad) = lengths.iter().find(|l| !l.is_finite()) {
+        return Err(VerneError::Usage(format!(
+            "--tool-length: `{bad}` is not a finite number of mm"
+        )));
+    }
+    if let Some(p) = &args.plot {
+        plot::Format::of_path(p).map_err(VerneError::Usage)?;
+    }
+    let bounds = args.bounds.map(|b| Bounds {
+        min: Vector3::new(b[0], b[2], b[4]),
+        max: Vector3::new(b[1], b[3], b[5]),
+    });
+    let lambda = args.lambda.unwrap_or(PAPER_LAMBDA_BOUNDS);
+    // Check every option before the first (possibly long) run.
+    for &l in &lengths {
+        let opts = options(of, l, step, bounds, lambda);
+        workspace::grid_for(&machine, &opts).map_err(VerneError::Usage)?;
+    }
+
+    let to_stdout = args.output.as_deref().is_some_and(|p| p.as_os_str() == "-");
+    let mut sink = match &args.output {
+        Some(p) => Some(Sink::create(Some(p.as_path()))?),
+        None => None,
+    };
+    if let Some(s) = sink.as_mut() {
+        s.write(&ByteRecord::from(POINTS_HEADER.to_vec()))?;
+    }
+    let mut rec = ByteRecord::new();
+    let mut summaries = Vec::new();
+    let mut text = String::new();
+    for &l in &lengths {
+        let opts = options(of, l, step, bounds, lambda);
+        let grid = workspace::grid_for(&machine, &opts).map_err(VerneError::Usage)?;
+        let bar = progress_bar(grid.len() as u64, of, l);
+        let tick = |n: u64| {
+            if let Some(b) = &bar {
+                b.set_position(n);
+            }
+        };
+        let tool = (of != Of::Platform).then_some(l);
+        let start = Instant::now();
+        let result = workspace::compute(&machine, &opts, &tick, |r| match sink.as_mut() {
+            Some(s) if !args.inside_only || r.outcome == Outcome::Inside => {
+                write_point(r, tool, u, &mut rec);
+                s.write(&rec)
+            }
+            _ => Ok(()),
+        });
+        let elapsed = start.elapsed();
+        if let Some(b) = &bar {
+            b.finish_and_clear();
+        }
+        let ws = match result {
+            Ok(Ok(ws)) => ws,
+            Ok(Err(msg)) => return Err(VerneError::Usage(msg)),
+            Err(e) => {
+                if let Some(s) = sink.as_mut() {
+                    s.discard();
+                }
+                return Err(e);
+            }
+        };
+        if let Some(p) = &args.plot {
+            let path = plot_path(p, &lengths, l);
+            let views: Vec<View> = if args.slice.is_empty() {
+                plot::default_views(&ws.summary)
+            } else {
+                let mut v: Vec<View> = args
+                    .slice
+                    .iter()
+                    .map(|&(axis, value)| View::Slice { axis, value })
+                    .collect();
+                v.extend([2, 1, 0].map(|axis| View::Projection { axis }));
+                v
+            };
+            let title = format!(
+                "{} workspace{}, step {} mm, {} ({}): {:.1} l",
+                of.name(),
+                tool.map(|t| format!(", tool length {t} mm"))
+                    .unwrap_or_default(),
+                step,
+                machine.name,
+                of.frame(),
+                ws.summary.volume_litres()
+            );
+            plot::workspace_picture(&path, &ws.map, &ws.summary, &views, &title).map_err(|e| {
+                VerneError::io(&path.display().to_string(), std::io::Error::other(e))
+            })?;
+        }
+        describe(&mut text, &ws.summary, elapsed);
+        summaries.push((ws.summary, elapsed));
+    }
+    if let Some(s) = sink {
+        s.finish()?;
+    }
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "verne workspace: {} ({}), machine {}",
+        match of {
+            Of::Platform => "platform point P",
+            Of::Tool => "tool tip, eq. (27)",
+            Of::Manufacturing => "tool tip with the table following the platform, eq. (26)",
+        },
+        of.frame(),
+        machine.name
+    );
+    let s0 = &summaries[0].0;
+    let _ = writeln!(
+        out,
+        "constraints: (i) leg-I rods cross, (ii) rod tilt <= {} deg, (iii) amplification factors in [{}, {}], (iv) strokes{}",
+        fmt_num(machine.limits.rod_tilt_max.to_degrees(), 3),
+        fmt_num(s0.lambda[0], 6),
+        fmt_num(s0.lambda[1], 6),
+        if of == Of::Manufacturing {
+            format!(
+                ", (v) theta1 = alpha in [{}, {}] deg",
+                fmt_num(machine.limits.theta1_min.to_degrees(), 3),
+                fmt_num(machine.limits.theta1_max.to_degrees(), 3)
+            )
+        } else {
+            String::new()
+        }
+    );
+    out.push_str(&text);
+    if lengths.len() > 1 {
+        let _ = writeln!(out, "\nvolume against tool length (step {} mm)", step);
+        let _ = writeln!(
+            out,
+            "{:>14}  {:>10}  {:>10}  {:>15}  {:>8}",
+            "tool_length_mm", "volume_l", "error_l", "largest_box_l", "time_s"
+        );
+        for (s, t) in &summaries {
+            let bx = s.largest_box_size().map_or(0.0, |(_, v)| v * 1e-6);
+            let _ = writeln!(
+                out,
+                "{:>14}  {:>10.2}  {:>10.2}  {:>15.2}  {:>8.1}",
+                fmt_num(s.tool_length, 3),
+                s.volume_litres(),
+                s.volume_error_mm3() * 1e-6,
+                bx,
+                t.as_secs_f64()
+            );
+        }
+    }
+    if to_stdout {
+        eprint!("{out}");
+    } else {
+        write_stdout(&out)?;
+    }
+    Ok(if summaries.iter().all(|(s, _)| s.inside > 0) {
+        EXIT_OK
+    } else {
+        EXIT_ROWS_FAILED
+    })
+}
+
+fn options(
+    of: Of,
+    l: f64,
+    step: f64,
+    bounds: Option<Bounds>,
+    lambda: [f64; 2],
+) -> WorkspaceOptions {
+    WorkspaceOptions {
+        of,
+        tool_length: if of == Of::Platform { 0.0 } else { l },
+        step,
+        bounds,
+        lambda,
+    }
+}
+
+/// FILE.svg for one workspace; FILE-L50.svg for tool length 50 when several are asked.
+fn plot_path(p: &Path, lengths: &[f64], l: f64) -> PathBuf {
+    if lengths.len() <= 1 {
+        return p.to_path_buf();
+    }
+    let stem = p
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let ext = p
+        .extension()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    p.with_file_name(format!("{stem}-L{}.{ext}", fmt_num(l, 3)))
+}
+
+fn fmt_num(v: f64, decimals: usize) -> String {
+    let s = format!("{v:.decimals$}");
+    let s = if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    };
+    if s == "-0" { "0".into() } else { s }
+}
+
+fn range(b: &Bounds) -> String {
+    format!(
+        "x [{}, {}]  y [{}, {}]  z [{}, {}] mm",
+        fmt_num(b.min.x, 3),
+        fmt_num(b.max.x, 3),
+        fmt_num(b.min.y, 3),
+        fmt_num(b.max.y, 3),
+        fmt_num(b.min.z, 3),
+        fmt_num(b.max.z, 3)
+    )
+}
+
+fn describe(out: &mut String, s: &WorkspaceSummary, elapsed: Duration) {
+    let g = &s.grid;
+    let _ = writeln!(out);
+    match s.of {
+        Of::Platform => {
+            let _ = writeln!(out, "platform workspace");
+        }
+        _ => {
+            let _ = writeln!(out, "tool length {} mm", fmt_num(s.tool_length, 3));
+        }
+    }
+    let _ = writeln!(
+        out,
+        "  grid               step {} mm over {}: {} x {} x {} = {} points",
+        fmt_num(g.step, 6),
+        range(&Bounds {
+            min: g.origin,
+            max: g.max()
+        }),
+        g.n[0],
+        g.n[1],
+        g.n[2],
+        s.points
+    );
+    let _ = writeln!(
+        out,
+        "  volume             {:.3} l = {:.6e} mm^3 ({} points inside x step^3)",
+        s.volume_litres(),
+        s.volume_mm3,
+        s.inside
+    );
+    let _ = writeln!(
+        out,
+        "  error estimate     +-{:.3} l (|V(h) - V(2h)|, V(2h) = {:.3} l on the even-index subgrid)",
+        s.volume_error_mm3() * 1e-6,
+        s.volume_double_step_mm3 * 1e-6
+    );
+    match &s.bbox {
+        Some(b) => {
+            let _ = writeln!(out, "  bounding box       {}", range(b));
+        }
+        None => {
+            let _ = writeln!(out, "  bounding box       (empty workspace)");
+        }
+    }
+    match s.largest_box_size() {
+        Some((b, v)) => {
+            let e = b.max - b.min;
+            let _ = writeln!(
+                out,
+                "  largest box        {}: {} x {} x {} mm = {:.3} l",
+                range(&b),
+                fmt_num(e.x, 3),
+                fmt_num(e.y, 3),
+                fmt_num(e.z, 3),
+                v * 1e-6
+            );
+        }
+        None => {
+            let _ = writeln!(out, "  largest box        (none with positive volume)");
+        }
+    }
+    if s.touches_bounds {
+        let _ = writeln!(
+            out,
+            "  warning            inside points lie on the grid's faces: the bounds cut the workspace"
+        );
+    }
+    let _ = writeln!(
+        out,
+        "  {:<40} {:>12} {:>12}",
+        "constraint", "binding", "fails"
+    );
+    for o in Outcome::ALL {
+        let fails = match o {
+            Outcome::Bound(c) => s.failures[c as usize].to_string(),
+            _ => String::new(),
+        };
+        if let Outcome::Bound(Constraint::Theta1Range) = o
+            && s.of != Of::Manufacturing
+        {
+            continue;
+        }
+        let _ = writeln!(
+            out,
+            "    {:<38} {:>12} {:>12}",
+            o.label(),
+            s.binding[o.index()],
+            fails
+        );
+    }
+    let secs = elapsed.as_secs_f64();
+    let _ = writeln!(
+        out,
+        "  time               {:.2} s, {:.0} points/s, {} threads",
+        secs,
+        s.points as f64 / secs.max(1e-9),
+        rayon::current_num_threads()
+    );
+}
+
+/// A bar over the grid points, shown only when stderr is a terminal.
+fn progress_bar(total: u64, of: Of, l: f64) -> Option<indicatif::ProgressBar> {
+    if !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let bar = indicatif::ProgressBar::new(total);
+    let label = match of {
+        Of::Platform => "platform".to_string(),
+        _ => format!("{} L={l}", of.name()),
+    };
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{prefix} {bar:30} {pos}/{len} points ({per_sec}, eta {eta})",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar.set_prefix(label);
+    bar.enable_steady_tick(Duration::from_millis(200));
+    Some(bar)
+}

@@ -1,0 +1,92 @@
+//! Entry points shared by the fuzz targets (fuzz/fuzz_targets) and the corpus replay test
+//! (tests/fuzz_corpus.rs): each feeds arbitrary bytes to one reader of user input and must
+//! return (an answer or an error), never panic or hang.
+
+use std::io::Cursor;
+
+use crate::engine::machine_rows::{MachineIk, OrientationColumns};
+use crate::engine::module_rows::{ModuleFkAll, ModuleFkWorking, ModuleIkAll, ModuleIkWorking};
+use crate::engine::pipeline::{self, Units};
+use crate::table::{CsvSource, Sink};
+use verne::machine::FirstRowChoice;
+use verne::spec::Machine;
+
+/// CSV rows through the module inverse (`fk == false`) or forward kinematics, every branch
+/// (`--all`) and the working one (the IK fast path, the FK tracker).
+pub fn csv_rows(data: &[u8], fk: bool) {
+    for all in [true, false] {
+        let Ok(mut source) = CsvSource::from_reader(Box::new(Cursor::new(data.to_vec())), "fuzz")
+        else {
+            return;
+        };
+        let mut sink = Sink::from_writer(Box::new(std::io::sink()), "sink");
+        let machine = Machine::default_verne();
+        let units = Units::default();
+        let (src, snk) = (&mut source, &mut sink);
+        let _ = match (fk, all) {
+            (true, true) => pipeline::run(&mut ModuleFkAll { machine }, src, snk, units, &|_| {}),
+            (true, false) => {
+                pipeline::run(&mut ModuleFkWorking { machine }, src, snk, units, &|_| {})
+            }
+            (false, true) => pipeline::run(&mut ModuleIkAll { machine }, src, snk, units, &|_| {}),
+            (false, false) => {
+                pipeline::run(&mut ModuleIkWorking { machine }, src, snk, units, &|_| {})
+            }
+        };
+    }
+}
+
+/// CSV tool poses (x,y,z with i,j,k or phi1,phi2) through the machine inverse kinematics along
+/// a path (`verne ik` on a toolpath), every branch (`--all`) and the followed one.
+pub fn csv_tool_rows(data: &[u8]) {
+    for orientation in [OrientationColumns::Axis, OrientationColumns::Angles] {
+        for all in [true, false] {
+            let Ok(mut source) =
+                CsvSource::from_reader(Box::new(Cursor::new(data.to_vec())), "fuzz")
+            else {
+                return;
+            };
+            let mut sink = Sink::from_writer(Box::new(std::io::sink()), "sink");
+            let machine = Machine::default_verne();
+            let tool_length = machine.tool_length;
+            let mut job = MachineIk::new(
+                machine,
+                tool_length,
+                orientation,
+                all,
+                FirstRowChoice::default(),
+            );
+            let _ = pipeline::run(&mut job, &mut source, &mut sink, Units::default(), &|_| {});
+        }
+    }
+}
+
+/// A machine file, TOML or key,value CSV.
+pub fn machine_file(data: &[u8]) {
+    if let Ok(text) = std::str::from_utf8(data) {
+        let _ = Machine::from_str_auto(text, "fuzz");
+    }
+}
+
+/// An APT CL file, read to the end or to its first error.
+pub fn apt_file(data: &[u8]) {
+    let mut reader = crate::input::apt::AptReader::new(Cursor::new(data));
+    while let Ok(Some(_)) = reader.next_row() {}
+}
+
+/// The command-line value parsers, on any text.
+pub fn arg_values(data: &[u8]) {
+    if let Ok(text) = std::str::from_utf8(data) {
+        use crate::arg_values::*;
+        let _ = parse_triple(text);
+        let _ = parse_bounds(text);
+        let _ = parse_pair(text);
+        let _ = parse_slice(text);
+        let _ = parse_ratio(text);
+        let _ = parse_positive(text);
+        let _ = parse_lambda_bounds(text);
+        let _ = parse_tool_pose(text);
+        let _ = parse_machine_joints(text);
+        let _ = parse_threshold(text);
+    }
+}

@@ -1,0 +1,338 @@
+//! The inputs of `verne verify`: the postprocessor's joint table (CSV) and the intended path (CSV
+//! or APT CL), read row by row for the core's checks ([`verne::verify::RowSource`]), with
+//! file/line/column errors for malformed cells.
+
+use std::io::BufRead;
+use std::path::Path;
+
+use csv::ByteRecord;
+use nalgebra::Vector3;
+use verne::error::shown;
+use verne::machine::orientation::{tool_axis, unit_axis};
+use verne::parallel_module::equations::Sliders;
+use verne::verify::{Item, JOINT_NAMES, JointSource, Joints, PathPoint, RowSource};
+
+use crate::error::VerneError;
+use crate::input::apt::{AptReader, MotionKind};
+use crate::table::{CellError, CsvSource, parse_number};
+
+/// Reads a cell as a number; a non-number is fatal (file, line, column), an empty or non-finite
+/// cell makes the row invalid.
+fn cell(
+    src_name: &str,
+    rec: &ByteRecord,
+    i: usize,
+    col: &str,
+    unit: &str,
+) -> Result<Result<f64, String>, VerneError> {
+    let field = rec.get(i).unwrap_or(b"");
+    match parse_number(field) {
+        Ok(v) => Ok(Ok(v)),
+        Err(CellError::NotFinite) => Ok(Err(format!(
+            "{col} is empty or not finite (`{}`)",
+            shown(field)
+        ))),
+        Err(CellError::NotANumber) => Err(VerneError::input(
+            src_name,
+            rec.position().map(|p| p.line()),
+            Some(col),
+            format!("expected a number ({unit}), found `{}`", shown(field)),
+        )),
+    }
+}
+
+/// The postprocessor's joint table: `rho1,rho2,rho3` (mm), `theta1,theta2` (deg); optional `id`,
+/// `t` (s), `feed` (mm/min).
+pub struct JointReader {
+    src: CsvSource,
+    cols: [usize; 5],
+    id: Option<usize>,
+    t: Option<usize>,
+    feed: Option<usize>,
+    rec: ByteRecord,
+    index: u64,
+}
+
+impl JointReader {
+    pub fn new(src: CsvSource) -> Result<JointReader, VerneError> {
+        let c = src.require(&JOINT_NAMES)?;
+        Ok(JointReader {
+            cols: [c[0], c[1], c[2], c[3], c[4]],
+            id: src.column("id"),
+            t: src.column("t"),
+            feed: src.column("feed"),
+            src,
+            rec: ByteRecord::new(),
+            index: 0,
+        })
+    }
+
+    pub fn name(&self) -> &str {
+        self.src.name()
+    }
+
+    pub fn has_id(&self) -> bool {
+        self.id.is_some()
+    }
+
+    /// True when velocities can be checked.
+    pub fn timed(&self) -> bool {
+        self.t.is_some() || self.feed.is_some()
+    }
+
+    pub fn next_item(&mut self) -> Result<Option<Item<Joints>>, VerneError> {
+        if !self.src.read(&mut self.rec)? {
+            return Ok(None);
+        }
+        self.index += 1;
+        let name = self.src.name().to_string();
+        let line = self.rec.position().map(|p| p.line()).unwrap_or(0);
+        let mut v = [0.0; 5];
+        let mut bad = None;
+        for k in 0..5 {
+            let unit = if k < 3 { "mm" } else { "degrees" };
+            match cell(&name, &self.rec, self.cols[k], JOINT_NAMES[k], unit)? {
+                Ok(x) => v[k] = if k < 3 { x } else { x.to_radians() },
+                Err(e) => {
+                    bad.get_or_insert(e);
+                }
+            }
+        }
+        let optional =
+            |i: Option<usize>, col: &str, unit: &str| -> Result<Option<f64>, VerneError> {
+                match i {
+                    None => Ok(None),
+                    Some(i) => Ok(cell(&name, &self.rec, i, col, unit)?.ok()),
+                }
+            };
+        let t = optional(self.t, "t", "s")?;
+        let feed = optional(self.feed, "feed", "mm/min")?.map(|f| f / 60.0);
+        let id = self
+            .id
+            .map(|i| String::from_utf8_lossy(self.rec.get(i).unwrap_or(b"")).into_owned());
+        let value = match bad {
+            Some(e) => Err(e),
+            None => Ok(Joints {
+                rho: Sliders::new(v[0], v[1], v[2]),
+                theta1: v[3],
+                theta2: v[4],
+                t,
+                feed,
+            }),
+        };
+        Ok(Some(Item {
+            index: self.index,
+            line,
+            id,
+            value,
+        }))
+    }
+}
+
+#[allow(clippy::large_enum_variant)] // one per run
+enum PathKind {
+    Csv {
+        src: CsvSource,
+        xyz: [usize; 3],
+        /// i,j,k or phi1,phi2 (then the third is unused).
+        orient: [usize; 3],
+        angles: bool,
+        id: Option<usize>,
+        rec: ByteRecord,
+    },
+    Apt {
+        reader: Box<AptReader<Box<dyn BufRead + Send>>>,
+    },
+}
+
+/// The intended path: a CSV (`x,y,z` and `i,j,k` or `phi1,phi2` in degrees, optional `id`) or an
+/// APT CL file (FROM and GOTO records in file order; a 3-value record has the axis (0, 0, 1)).
+pub struct PathReader {
+    kind: PathKind,
+    name: String,
+    index: u64,
+}
+
+impl PathReader {
+    /// Opens a path file: `.cl`, `.apt`, `.cls` (any case) as APT, anything else as CSV.
+    pub fn open(path: &Path) -> Result<PathReader, VerneError> {
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
+        let name = path.display().to_string();
+        if matches!(ext.as_str(), "cl" | "apt" | "cls") {
+            let f = std::fs::File::open(path).map_err(|e| VerneError::io(&name, e))?;
+            let r: Box<dyn BufRead + Send> = Box::new(std::io::BufReader::new(f));
+            return Ok(PathReader {
+                kind: PathKind::Apt {
+                    reader: Box::new(AptReader::new(r)),
+                },
+                name,
+                index: 0,
+            });
+        }
+        Self::from_csv(CsvSource::open(Some(path))?)
+    }
+
+    /// A CSV path from an opened source.
+    pub fn from_csv(src: CsvSource) -> Result<PathReader, VerneError> {
+        let xyz = src.require(&["x", "y", "z"])?;
+        let (orient, angles) = if src.column("i").is_some() || src.column("phi1").is_none() {
+            let c = src.require(&["x", "y", "z", "i", "j", "k"])?;
+            ([c[3], c[4], c[5]], false)
+        } else {
+            let c = src.require(&["x", "y", "z", "phi1", "phi2"])?;
+            ([c[3], c[4], c[4]], true)
+        };
+        Ok(PathReader {
+            name: src.name().to_string(),
+            kind: PathKind::Csv {
+                xyz: [xyz[0], xyz[1], xyz[2]],
+                orient,
+                angles,
+                id: src.column("id"),
+                src,
+                rec: ByteRecord::new(),
+            },
+            index: 0,
+        })
+    }
+
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    pub fn has_id(&self) -> bool {
+        matches!(&self.kind, PathKind::Csv { id: Some(_), .. })
+    }
+
+    pub fn next_item(&mut self) -> Result<Option<Item<PathPoint>>, VerneError> {
+        match &mut self.kind {
+            PathKind::Apt { reader } => {
+                let row = reader
+                    .next_row()
+                    .map_err(|e| VerneError::input(&self.name, None, None, e.to_string()))?;
+                let Some(row) = row else { return Ok(None) };
+                self.index += 1;
+                let axis = row.axis.unwrap_or(Vector3::new(0.0, 0.0, 1.0));
+                let value = unit_axis(&axis)
+                    .map(|axis| PathPoint { tip: row.tip, axis })
+                    .map_err(|e| {
+                        format!(
+                            "{} at line {}: {e}",
+                            if row.kind == MotionKind::From {
+                                "FROM"
+                            } else {
+                                "GOTO"
+                            },
+                            row.line
+                        )
+                    });
+                Ok(Some(Item {
+                    index: self.index,
+                    line: row.line as u64,
+                    id: None,
+                    value,
+                }))
+            }
+            PathKind::Csv {
+                src,
+                xyz,
+                orient,
+                angles,
+                id,
+                rec,
+            } => {
+                if !src.read(rec)? {
+                    return Ok(None);
+                }
+                self.index += 1;
+                let name = src.name().to_string();
+                let line = rec.position().map(|p| p.line()).unwrap_or(0);
+                let names: [&str; 6] = if *angles {
+                    ["x", "y", "z", "phi1", "phi2", "phi2"]
+                } else {
+                    ["x", "y", "z", "i", "j", "k"]
+                };
+                let cols = [xyz[0], xyz[1], xyz[2], orient[0], orient[1], orient[2]];
+                let mut v = [0.0; 6];
+                let mut bad = None;
+                for k in 0..6 {
+                    let unit = if k < 3 {
+                        "mm"
+                    } else if *angles {
+                        "degrees"
+                    } else {
+                        "unit vector component"
+                    };
+                    match cell(&name, rec, cols[k], names[k], unit)? {
+                        Ok(x) => v[k] = x,
+                        Err(e) => {
+                            bad.get_or_insert(e);
+                        }
+                    }
+                }
+                let id =
+                    id.map(|i| String::from_utf8_lossy(rec.get(i).unwrap_or(b"")).into_owned());
+                let tip = Vector3::new(v[0], v[1], v[2]);
+                let value = match bad {
+                    Some(e) => Err(e),
+                    None if *angles => Ok(PathPoint {
+                        tip,
+                        axis: tool_axis(v[3].to_radians(), v[4].to_radians()),
+                    }),
+                    None => unit_axis(&Vector3::new(v[3], v[4], v[5]))
+                        .map(|axis| PathPoint { tip, axis })
+                        .map_err(|e| e.to_string()),
+                };
+                Ok(Some(Item {
+                    index: self.index,
+                    line,
+                    id,
+                    value,
+                }))
+            }
+        }
+    }
+}
+
+impl RowSource for JointReader {
+    type Row = Joints;
+    type Error = VerneError;
+
+    fn name(&self) -> &str {
+        JointReader::name(self)
+    }
+
+    fn has_id(&self) -> bool {
+        JointReader::has_id(self)
+    }
+
+    fn next_item(&mut self) -> Result<Option<Item<Joints>>, VerneError> {
+        JointReader::next_item(self)
+    }
+}
+
+impl JointSource for JointReader {
+    fn timed(&self) -> bool {
+        JointReader::timed(self)
+    }
+}
+
+impl RowSource for PathReader {
+    type Row = PathPoint;
+    type Error = VerneError;
+
+    fn name(&self) -> &str {
+        PathReader::name(self)
+    }
+
+    fn has_id(&self) -> bool {
+        PathReader::has_id(self)
+    }
+
+    fn next_item(&mut self) -> Result<Option<Item<PathPoint>>, VerneError> {
+        PathReader::next_item(self)
+    }
+}

@@ -1,0 +1,566 @@
+//! CSV tables: the only place that builds csv readers and writers. Reading checks headers once
+//! and parses numbers with file/line/column errors; writing goes to stdout or to a temporary file
+//! beside the target that is renamed into place only when the run succeeds.
+
+use std::fs::File;
+use std::io::{self, BufWriter, Read, Write};
+use std::path::{Path, PathBuf};
+
+use csv::ByteRecord;
+
+use verne::error::shown;
+
+use crate::error::VerneError;
+
+/// A CSV input with a header row (file or stdin).
+pub struct CsvSource {
+    reader: csv::Reader<Box<dyn Read + Send>>,
+    name: String,
+    headers: ByteRecord,
+    /// The record as read, before its fields are trimmed into the caller's record.
+    raw: ByteRecord,
+}
+
+impl CsvSource {
+    /// Opens `path`; `None` or `-` reads standard input.
+    pub fn open(path: Option<&Path>) -> Result<CsvSource, VerneError> {
+        match path {
+            None => Self::from_reader(Box::new(io::stdin()), "<stdin>"),
+            Some(p) if p.as_os_str() == "-" => Self::from_reader(Box::new(io::stdin()), "<stdin>"),
+            Some(p) => {
+                let name = p.display().to_string();
+                let f = File::open(p).map_err(|e| VerneError::io(&name, e))?;
+                Self::from_reader(Box::new(io::BufReader::with_capacity(1 << 16, f)), &name)
+            }
+        }
+    }
+
+    /// Reads CSV text from any reader; `name` is used in error messages.
+    pub fn from_reader(r: Box<dyn Read + Send>, name: &str) -> Result<CsvSource, VerneError> {
+        let mut reader = csv::ReaderBuilder::new()
+            .has_headers(true)
+            // Fields are trimmed by `read` without the per-record allocation of Trim::All.
+            .trim(csv::Trim::Headers)
+            .comment(None)
+            .buffer_capacity(1 << 16)
+            .from_reader(r);
+        let headers = match reader.byte_headers() {
+            Ok(h) => h.clone(),
+            Err(e) => return Err(csv_error(name, e)),
+        };
+        if headers.is_empty() || (headers.len() == 1 && headers[0].is_empty()) {
+            return Err(VerneError::input(
+                name,
+                Some(1),
+                None,
+                "empty input: expected a CSV header line",
+            ));
+        }
+        let mut headers_clean = ByteRecord::new();
+        for (i, h) in headers.iter().enumerate() {
+            // A UTF-8 byte-order mark before the first name is accepted and dropped.
+            let h = if i == 0 {
+                h.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(h)
+            } else {
+                h
+            };
+            headers_clean.push_field(h);
+        }
+        let src = CsvSource {
+            reader,
+            name: name.to_string(),
+            headers: headers_clean,
+            raw: ByteRecord::new(),
+        };
+        src.check_duplicate_headers()?;
+        Ok(src)
+    }
+
+    fn check_duplicate_headers(&self) -> Result<(), VerneError> {
+        for (i, h) in self.headers.iter().enumerate() {
+            if self.headers.iter().take(i).any(|o| o == h) {
+                return Err(VerneError::input(
+                    &self.name,
+                    Some(1),
+                    Some(&shown(h)),
+                    format!(
+                        "column `{}` appears twice in the header; expected unique column names",
+                        shown(h)
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    pub fn headers(&self) -> &ByteRecord {
+        &self.headers
+    }
+
+    /// Index of a column by exact name.
+    pub fn column(&self, name: &str) -> Option<usize> {
+        self.headers.iter().position(|h| h == name.as_bytes())
+    }
+
+    /// Indices of the required columns, or an error naming the missing ones and the header found.
+    pub fn require(&self, names: &[&str]) -> Result<Vec<usize>, VerneError> {
+        let missing: Vec<&str> = names
+            .iter()
+            .copied()
+            .filter(|n| self.column(n).is_none())
+            .collect();
+        if missing.is_empty() {
+            return Ok(names.iter().map(|n| self.column(n).unwrap_or(0)).collect());
+        }
+        Err(VerneError::input(
+            &self.name,
+            Some(1),
+            None,
+            format!(
+                "missing column{} {}; expected a header with {}, found `{}`{}",
+                if missing.len() > 1 { "s" } else { "" },
+                missing
+                    .iter()
+                    .map(|m| format!("`{m}`"))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                names.join(","),
+                self.header_text(),
+                if self.headers.len() == 1 && self.header_text().contains(';') {
+                    " (the file looks separated by `;`; verne reads comma-separated values)"
+                } else {
+                    ""
+                }
+            ),
+        ))
+    }
+
+    /// The header as text for a message, shortened to [`MESSAGE_CHARS`](verne::error::MESSAGE_CHARS).
+    pub fn header_text(&self) -> String {
+        let joined: Vec<u8> = self.headers.iter().collect::<Vec<_>>().join(&b","[..]);
+        shown(&joined)
+    }
+
+    /// Reads the next record into `rec`; false at the end of the input.
+    /// Every field has its surrounding ASCII white space removed.
+    pub fn read(&mut self, rec: &mut ByteRecord) -> Result<bool, VerneError> {
+        match self.reader.read_byte_record(&mut self.raw) {
+            Ok(true) => {}
+            Ok(false) => return Ok(false),
+            Err(e) => return Err(csv_error(&self.name, e)),
+        }
+        let padded = |f: &[u8]| {
+            f.first().is_some_and(u8::is_ascii_whitespace)
+                || f.last().is_some_and(u8::is_ascii_whitespace)
+        };
+        if self.raw.iter().any(padded) {
+            rec.clear();
+            rec.set_position(self.raw.position().cloned());
+            for f in self.raw.iter() {
+                rec.push_field(f.trim_ascii());
+            }
+        } else {
+            std::mem::swap(rec, &mut self.raw);
+        }
+        Ok(true)
+    }
+}
+
+fn csv_error(name: &str, e: csv::Error) -> VerneError {
+    let line = e.position().map(|p| p.line());
+    match e.into_kind() {
+        csv::ErrorKind::UnequalLengths {
+            expected_len, len, ..
+        } => VerneError::input(
+            name,
+            line,
+            None,
+            format!(
+                "row has {len} field{}; expected {expected_len} like the header (an unterminated quote also reads to the end of the file)",
+                if len == 1 { "" } else { "s" }
+            ),
+        ),
+        csv::ErrorKind::Io(io) => VerneError::io(name, io),
+        other => VerneError::input(name, line, None, format!("malformed CSV: {other:?}")),
+    }
+}
+
+/// A number cell could not be read.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CellError {
+    /// Not a number at all (text, units, decimal comma): the file is malformed.
+    NotANumber,
+    /// Empty, NaN or infinite: the row is invalid, the run goes on.
+    NotFinite,
+}
+
+/// Parses a numeric cell (surrounding spaces already trimmed by the reader).
+#[inline]
+pub fn parse_number(field: &[u8]) -> Result<f64, CellError> {
+    if field.is_empty() {
+        return Err(CellError::NotFinite);
+    }
+    let s = std::str::from_utf8(field).map_err(|_| CellError::NotANumber)?;
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(_) => Err(CellError::NotFinite),
+        Err(_) => Err(CellError::NotANumber),
+    }
+}
+
+/// Appends one field of a CSV record: after a `delimiter` unless it is the first, quoted only
+/// where needed, as the csv crate's writer does (a field holding the delimiter, a quote, CR or
+/// LF; quotes inside doubled).
+#[inline]
+pub fn encode_field(out: &mut Vec<u8>, delimiter: u8, first: bool, field: &[u8]) {
+    if !first {
+        out.push(delimiter);
+    }
+    // Bytes above b'"' other than the delimiter never need quotes: one comparison per byte.
+    let special = |b: u8| b <= b'"' && (b == b'"' || b == b'\n' || b == b'\r' || b == delimiter);
+    if !field.iter().any(|&b| special(b) || b == delimiter) {
+        out.extend_from_slice(field);
+        return;
+    }
+    out.push(b'"');
+    for &b in field {
+        if b == b'"' {
+            out.push(b'"');
+        }
+        out.push(b);
+    }
+    out.push(b'"');
+}
+
+/// Where output goes: stdout, or a file written atomically. Records are CSV-encoded by
+/// [`encode_field`]; a caller may also hand over text it encoded itself ([`Sink::write_encoded`]).
+pub struct Sink {
+    writer: Box<dyn Write + Send>,
+    delimiter: u8,
+    scratch: Vec<u8>,
+    target: Option<(PathBuf, PathBuf)>,
+    name: String,
+}
+
+impl Sink {
+    /// `None` or `-` is stdout; a path is written through a temporary file in the same directory.
+    pub fn create(path: Option<&Path>) -> Result<Sink, VerneError> {
+        Sink::create_delimited(path, b',')
+    }
+
+    /// As [`Sink::create`], with another field delimiter (b' ' for halstreamer).
+    pub fn create_delimited(path: Option<&Path>, delimiter: u8) -> Result<Sink, VerneError> {
+        let (writer, target, name): (Box<dyn Write + Send>, _, String) = match path {
+            Some(p) if p.as_os_str() != "-" => {
+                let name = p.display().to_string();
+                let dest = output_destination(p);
+                if dest.in_place {
+                    let f = std::fs::OpenOptions::new()
+                        .write(true)
+                        .open(&dest.path)
+                        .map_err(|e| VerneError::io(&name, e))?;
+                    (Box::new(BufWriter::with_capacity(1 << 16, f)), None, name)
+                } else {
+                    let tmp = temp_path_for(&dest.path);
+                    let f = File::create(&tmp).map_err(|e| VerneError::io(&name, e))?;
+                    (
+                        Box::new(BufWriter::with_capacity(1 << 16, f)),
+                        Some((tmp, dest.path)),
+                        name,
+                    )
+                }
+            }
+            _ => (
+                Box::new(BufWriter::with_capacity(1 << 16, io::stdout())),
+                None,
+                "<stdout>".to_string(),
+            ),
+        };
+        if let Some((tmp, _)) = &target {
+            crate::table::register_temp(tmp);
+        }
+        Ok(Sink {
+            writer,
+            delimiter,
+            scratch: Vec::new(),
+            target,
+            name,
+        })
+    }
+
+    /// A sink over any writer (tests, fuzzing, in-memory output).
+    pub fn from_writer(w: Box<dyn Write + Send>, name: &str) -> Sink {
+        Sink {
+            writer: w,
+            delimiter: b',',
+            scratch: Vec::new(),
+            target: None,
+            name: name.to_string(),
+        }
+    }
+
+    /// The field delimiter of the records this sink writes.
+    pub fn delimiter(&self) -> u8 {
+        self.delimiter
+    }
+
+    /// Writes one record.
+    pub fn write(&mut self, rec: &ByteRecord) -> Result<(), VerneError> {
+        self.scratch.clear();
+        if rec.len() == 1 && rec[0].is_empty() {
+            // A lone empty field is written quoted, or the line would read as no record.
+            self.scratch.extend_from_slice(b"\"\"");
+        } else {
+            for (i, f) in rec.iter().enumerate() {
+                encode_field(&mut self.scratch, self.delimiter, i == 0, f);
+            }
+        }
+        self.scratch.push(b'\n');
+        let Sink {
+            writer,
+            scratch,
+            name,
+            ..
+        } = self;
+        writer
+            .write_all(scratch)
+            .map_err(|e| VerneError::io(name, e))
+    }
+
+    /// Writes records already encoded (with [`encode_field`] and this sink's delimiter, each
+    /// ended by a line feed).
+    pub fn write_encoded(&mut self, bytes: &[u8]) -> Result<(), VerneError> {
+        self.writer
+            .write_all(bytes)
+            .map_err(|e| VerneError::io(&self.name, e))
+    }
+
+    /// Flushes and, for a file, renames the temporary file into place.
+    pub fn finish(mut self) -> Result<(), VerneError> {
+        let flushed = self
+            .writer
+            .flush()
+            .map_err(|e| VerneError::io(&self.name, e));
+        if let Err(e) = flushed {
+            self.discard();
+            return Err(e);
+        }
+        if let Some((tmp, dest)) = self.target.take() {
+            // Close the file before renaming.
+            drop(std::mem::replace(&mut self.writer, Box::new(io::sink())));
+            let renamed = std::fs::rename(&tmp, &dest);
+            unregister_temp(&tmp);
+            if let Err(e) = renamed {
+                let _ = std::fs::remove_file(&tmp);
+                return Err(VerneError::io(&self.name, e));
+            }
+        }
+        Ok(())
+    }
+
+    /// Abandons the output: the temporary file is removed, the target is left untouched.
+    pub fn discard(&mut self) {
+        if let Some((tmp, _)) = self.target.take() {
+            let _ = std::fs::remove_file(&tmp);
+            unregister_temp(&tmp);
+        }
+    }
+}
+
+impl Drop for Sink {
+    fn drop(&mut self) {
+        self.discard();
+    }
+}
+
+/// Where an output file is written ([`output_destination`]).
+pub struct OutputDestination {
+    /// The file to write or to rename into place (a symlink's target).
+    pub path: PathBuf,
+    /// Written directly, not through a temporary file renamed into place.
+    pub in_place: bool,
+}
+
+/// Where output named `path` goes. A device, a FIFO or a socket (`/dev/null`, `/dev/stdout`, a
+/// named pipe) is written in place: renaming a file over it would replace the node itself (and
+/// `/dev/null` with it, for root). Anything else goes through a temporary file beside the
+/// final file, renamed into place on success; a symlink is followed, so that it keeps pointing
+/// at the output.
+pub fn output_destination(path: &Path) -> OutputDestination {
+    match std::fs::metadata(path) {
+        Ok(m) if !m.is_file() && !m.is_dir() => OutputDestination {
+            path: path.to_path_buf(),
+            in_place: true,
+        },
+        Ok(_) if path.is_symlink() => OutputDestination {
+            path: std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf()),
+            in_place: false,
+        },
+        _ => OutputDestination {
+            path: path.to_path_buf(),
+            in_place: false,
+        },
+    }
+}
+
+/// Writes `bytes` as the output file `path`, as [`Sink`] does: through a temporary file beside
+/// it, renamed into place (nothing is left behind on an error), or in place for a device or a
+/// FIFO ([`output_destination`]).
+pub fn write_output(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    let dest = output_destination(path);
+    if dest.in_place {
+        return std::fs::write(&dest.path, bytes);
+    }
+    let tmp = temp_path_for(&dest.path);
+    std::fs::write(&tmp, bytes)
+        .and_then(|_| std::fs::rename(&tmp, &dest.path))
+        .inspect_err(|_| {
+            let _ = std::fs::remove_file(&tmp);
+        })
+}
+
+/// `dir/.name.verne-PID.tmp` beside the target.
+fn temp_path_for(p: &Path) -> PathBuf {
+    let file = p
+        .file_name()
+        .map(|f| f.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "out".into());
+    let tmp = format!(".{file}.verne-{}.tmp", std::process::id());
+    match p.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.join(tmp),
+        _ => PathBuf::from(tmp),
+    }
+}
+
+static TEMP_FILES: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+fn register_temp(p: &Path) {
+    if let Ok(mut v) = TEMP_FILES.lock() {
+        v.push(p.to_path_buf());
+    }
+}
+
+fn unregister_temp(p: &Path) {
+    if let Ok(mut v) = TEMP_FILES.lock() {
+        v.retain(|q| q != p);
+    }
+}
+
+/// Removes every temporary output file still open (for a signal handler or a fatal exit).
+pub fn remove_temp_files() {
+    if let Ok(v) = TEMP_FILES.lock() {
+        for p in v.iter() {
+            let _ = std::fs::remove_file(p);
+        }
+    }
+}
+
+/// Appends a number to `out`: shortest round-trip form, or a fixed number of decimals.
+#[inline]
+pub fn format_number(out: &mut Vec<u8>, v: f64, decimals: Option<usize>) {
+    let v = if v == 0.0 { 0.0 } else { v }; // no "-0"
+    match decimals {
+        None => {
+            let mut buf = ryu::Buffer::new();
+            let s = buf.format(v);
+            let s = s.strip_suffix(".0").unwrap_or(s);
+            out.extend_from_slice(s.as_bytes());
+        }
+        Some(d) => {
+            let _ = write!(out, "{v:.d$}");
+        }
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    /// The sink's encoding is byte for byte the csv crate's writer's, on random records of
+    /// random bytes (delimiters, quotes, CR, LF, spaces, non-ASCII) for both delimiters.
+    #[test]
+    fn encoding_matches_the_csv_writer() {
+        let alphabet = b"a1,;\" \r\n.\t-\xC3\xA9e";
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = |n: usize| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state % n as u64) as usize
+        };
+        for delimiter in [b',', b' '] {
+            for _ in 0..20_000 {
+                let fields = 1 + next(5);
+                let mut rec = ByteRecord::new();
+                for _ in 0..fields {
+                    let len = next(6);
+                    let f: Vec<u8> = (0..len).map(|_| alphabet[next(alphabet.len())]).collect();
+                    rec.push_field(&f);
+                }
+                let buf = SharedBuf::default();
+                let mut sink = Sink::from_writer(Box::new(buf.clone()), "t");
+                sink.delimiter = delimiter;
+                sink.write(&rec).unwrap();
+                drop(sink);
+                let ours = buf.0.lock().unwrap().clone();
+                let mut theirs = csv::WriterBuilder::new()
+                    .delimiter(delimiter)
+                    .from_writer(Vec::new());
+                theirs.write_byte_record(&rec).unwrap();
+                let theirs = theirs.into_inner().unwrap();
+                assert_eq!(
+                    String::from_utf8_lossy(&ours),
+                    String::from_utf8_lossy(&theirs),
+                    "{rec:?}"
+                );
+            }
+        }
+    }
+
+    /// A writer into a Vec the test keeps (the sink takes a boxed 'static writer).
+    #[derive(Clone, Default)]
+    pub(crate) struct SharedBuf(pub(crate) std::sync::Arc<std::sync::Mutex<Vec<u8>>>);
+    impl Write for SharedBuf {
+        fn write(&mut self, b: &[u8]) -> io::Result<usize> {
+            self.0.lock().unwrap().extend_from_slice(b);
+            Ok(b.len())
+        }
+        fn flush(&mut self) -> io::Result<()> {
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn numbers_parse_and_classify() {
+        assert_eq!(parse_number(b"1.5"), Ok(1.5));
+        assert_eq!(parse_number(b"-2e3"), Ok(-2000.0));
+        assert_eq!(parse_number(b"NaN"), Err(CellError::NotFinite));
+        assert_eq!(parse_number(b"inf"), Err(CellError::NotFinite));
+        assert_eq!(parse_number(b""), Err(CellError::NotFinite));
+        assert_eq!(parse_number(b"1,5"), Err(CellError::NotANumber));
+        assert_eq!(parse_number(b"12mm"), Err(CellError::NotANumber));
+        assert_eq!(parse_number(b"\xff"), Err(CellError::NotANumber));
+    }
+
+    #[test]
+    fn numbers_format_round_trip() {
+        for v in [0.1, -0.0, 368.354796, 1e-7, 123456.0, -2.5e-12] {
+            let mut out = Vec::new();
+            format_number(&mut out, v, None);
+            let s = String::from_utf8(out).unwrap();
+            assert_eq!(
+                s.parse::<f64>().unwrap(),
+                if v == 0.0 { 0.0 } else { v },
+                "{s}"
+            );
+            assert!(!s.starts_with("-0") || v != 0.0);
+        }
+        let mut out = Vec::new();
+        format_number(&mut out, 2.0, None);
+        assert_eq!(out, b"2");
+    }
+}

@@ -1,0 +1,148 @@
+//! The workspace's pictures (both formats, and the branch schematic of one query) and the
+//! `verne workspace` command: it writes the points its summary counts (the workspace's
+//! invariants are in crates/verne/tests/workspace.rs).
+
+use std::process::Command;
+
+use nalgebra::Vector3;
+use verne::parallel_module::equations::ModulePose;
+use verne::parallel_module::ik;
+use verne::spec::Machine;
+use verne::workspace::{self, Of, PAPER_LAMBDA_BOUNDS, PointResult, Workspace, WorkspaceOptions};
+use verne_cli::plot;
+
+fn options(of: Of, tool_length: f64, step: f64) -> WorkspaceOptions {
+    WorkspaceOptions {
+        of,
+        tool_length,
+        step,
+        bounds: None,
+        lambda: PAPER_LAMBDA_BOUNDS,
+    }
+}
+
+fn run(m: &Machine, opts: &WorkspaceOptions) -> (Workspace, Vec<PointResult>) {
+    let mut points = Vec::new();
+    let ws = workspace::compute::<()>(m, opts, &|_| {}, |r| {
+        points.push(*r);
+        Ok(())
+    })
+    .unwrap()
+    .unwrap();
+    (ws, points)
+}
+
+#[test]
+fn pictures_are_written_in_both_formats() {
+    let m = Machine::default_verne();
+    let (ws, _) = run(&m, &options(Of::Tool, 50.0, 60.0));
+    let dir = std::env::temp_dir().join(format!("verne-ws-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for name in ["ws.svg", "ws.png"] {
+        let path = dir.join(name);
+        let views = plot::default_views(&ws.summary);
+        plot::workspace_picture(&path, &ws.map, &ws.summary, &views, "test").unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        assert!(bytes.len() > 1000, "{name}: {} bytes", bytes.len());
+    }
+    let svg = std::fs::read_to_string(dir.join("ws.svg")).unwrap();
+    assert!(svg.contains("slice z") && svg.contains("(ii) rod tilt"));
+    // Branch schematic of the IFToMM reference point: sixteen branches.
+    let p = Vector3::new(-240.0, -86.0, 1000.0);
+    let sketches: Vec<plot::BranchSketch> = ik::solve(&m, &p)
+        .iter()
+        .enumerate()
+        .map(|(k, b)| plot::BranchSketch {
+            pose: ModulePose { p, alpha: b.alpha },
+            rho: b.rho,
+            label: format!(
+                "{}: s=({},{},{})",
+                k + 1,
+                b.config[0],
+                b.config[1],
+                b.config[2]
+            ),
+            detail: b.verdict.to_string(),
+            working: b.working(),
+        })
+        .collect();
+    assert_eq!(sketches.len(), 16);
+    let path = dir.join("modes.svg");
+    plot::branches_picture(&path, &m, "P = (-240, -86, 1000)", &sketches).unwrap();
+    assert!(
+        std::fs::read_to_string(&path)
+            .unwrap()
+            .contains("rods_cross, rod_tilt")
+    );
+    assert!(
+        plot::workspace_picture(
+            &dir.join("x.pdf"),
+            &ws.map,
+            &ws.summary,
+            &[plot::View::Projection { axis: 2 }],
+            ""
+        )
+        .is_err()
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn the_command_writes_the_points_its_summary_counts() {
+    let dir = std::env::temp_dir().join(format!("verne-wscli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = dir.join("points.csv");
+    let svg = dir.join("ws.svg");
+    let out = Command::new(env!("CARGO_BIN_EXE_verne"))
+        .args([
+            "workspace",
+            "--of",
+            "tool",
+            "--tool-length",
+            "0,100",
+            "--step",
+            "60",
+            "-o",
+        ])
+        .arg(&csv)
+        .arg("--plot")
+        .arg(&svg)
+        .output()
+        .unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("volume against tool length"), "{text}");
+    let inside_counts: Vec<u64> = text
+        .lines()
+        .filter_map(|l| l.trim().strip_prefix("inside"))
+        .map(|rest| rest.trim().parse().unwrap())
+        .collect();
+    assert_eq!(inside_counts.len(), 2, "{text}");
+    let points = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = points.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "tool_length,x,y,z,xp,yp,zp,alpha,rho1,rho2,rho3,lambda1,lambda2,lambda3,status,fails"
+    );
+    for (k, len) in ["0", "100"].iter().enumerate() {
+        let n = points
+            .lines()
+            .filter(|l| l.starts_with(&format!("{len},")) && l.contains(",inside,"))
+            .count() as u64;
+        assert_eq!(n, inside_counts[k]);
+    }
+    assert!(dir.join("ws-L0.svg").exists() && dir.join("ws-L100.svg").exists());
+    // The platform has no tool: a usage error, exit 2.
+    let bad = Command::new(env!("CARGO_BIN_EXE_verne"))
+        .args(["workspace", "--of", "platform", "--tool-length", "50"])
+        .output()
+        .unwrap();
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("--tool-length"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -1,0 +1,32 @@
+//! verne: exact kinematics of the VERNE hybrid machine tool and of planar glider mechanisms.
+//!
+//! This crate computes; the `verne` command (crate `verne-cli`) talks. Nothing here prints,
+//! exits, reads a CSV or knows the command line: results are typed values. The folders follow
+//! the concepts (ARCHITECTURE.md):
+//!
+//! - [`spec`]: the machine's parameters and its machine file (TOML or key,value CSV);
+//! - [`parallel_module`]: the 3-DOF parallel module of IFToMM 2007 (equations (3)-(6), inverse
+//!   and forward kinematics, branch labels, tracking, kinetostatics);
+//! - [`machine`]: the whole machine of AIM 2007 (module plus tilting table, tool orientation,
+//!   a toolpath followed on one branch);
+//! - [`workspace`], [`verify`], [`selftest`]: analyses built on them;
+//! - [`glider`]: the planar glider mechanisms of the comparative study (Wenger 2001);
+//! - [`math`]: root finding, interval and double-double arithmetic, the run-time CPU dispatch;
+//! - [`details`]: the fast batched entry points and the baseline builds the benchmarks compare.
+//!
+//! The `parallel` feature (on by default) runs grids and batches on rayon's threads; without it
+//! the same computations run in order, with the same results.
+
+pub mod certificate;
+pub mod details;
+pub mod error;
+pub mod glider;
+pub mod machine;
+pub mod math;
+mod par;
+pub mod parallel_module;
+pub mod selftest;
+pub mod spec;
+pub mod tolerance;
+pub mod verify;
+pub mod workspace;

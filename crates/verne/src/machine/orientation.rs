@@ -1,0 +1,186 @@
+//! Tool orientation in the workpiece (tilting-table) frame R_t: the angles (phi1, phi2) of
+//! AIM 2007 eq. (8), the CAM tool-axis vector (i, j, k), and the map between them.
+//!
+//! Convention (derived from eq. (8), see docs/conventions-machine.md): the tool axis is the unit
+//! vector from the tool tip U towards the spindle (the platform point P), in R_t, whose z_t axis
+//! is the table normal pointing away from the table top (towards the spindle). From
+//! tT_pl = trans(X, Y, Z) rot(z, phi2) rot(x, pi + phi1) trans(z, -Delta), P = U + Delta a with
+//!
+//!   a = rot(z, phi2) rot(x, pi + phi1) (0, 0, -1) = (sin phi1 sin phi2, -sin phi1 cos phi2, cos phi1).
+//!
+//! So phi1 is the tilt of the tool from the table normal and phi2 the azimuth of the tilt plane:
+//! phi1 > 0, phi2 = 0 leans the tool towards -y_t. The pairs (phi1, phi2) and (-phi1, phi2 + pi)
+//! give the same axis. On the table normal (phi1 = 0) phi2 is undetermined: the rotary
+//! singularity.
+
+use nalgebra::Vector3;
+use std::f64::consts::PI;
+use std::fmt;
+
+use crate::parallel_module::ik::wrap_angle;
+
+/// Half-angle (rad) of the cone around the table normal (and its opposite) inside which phi2 is
+/// treated as undetermined. 1e-6 rad is the resolution of a tool axis printed with six decimals
+/// (the usual CL precision), so a smaller tilt is not distinguishable from zero in the input;
+/// and keeping the previous theta2 there changes the achieved axis by at most this angle, which
+/// moves the spindle end of a 500 mm tool by 0.5 um, below the machine's resolution. Outside
+/// the cone, double rounding of (i, j) perturbs phi2 by at most ~1e-16 / 1e-6 = 1e-10 rad.
+pub const ROTARY_SINGULAR_CONE_RAD: f64 = 1e-6;
+
+/// A tool-axis vector whose length differs from 1 by at most this (dimensionless) is normalised;
+/// a larger difference is an error. CL files print axes with 4 to 7 decimals, which leaves the
+/// length off by at most ~2e-4.
+pub const AXIS_NORM_TOL: f64 = 1e-3;
+
+/// Tool orientation angles (rad) of AIM 2007 eq. (8), relative to the workpiece frame R_t.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ToolAngles {
+    /// Tilt of the tool from the table normal.
+    pub phi1: f64,
+    /// Azimuth of the tilt plane about the table normal.
+    pub phi2: f64,
+}
+
+/// A tool orientation as given by the user.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ToolOrientation {
+    /// The angles themselves: used as given (one solution, theta2 = -phi2).
+    Angles(ToolAngles),
+    /// A CAM tool-axis vector (i, j, k) in R_t, tip towards spindle; normalised if nearly unit.
+    Axis(Vector3<f64>),
+}
+
+/// Why a tool-axis vector was rejected.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum AxisError {
+    /// A component is NaN or infinite.
+    NotFinite,
+    /// The vector is (0, 0, 0).
+    Zero,
+    /// The length is off 1 by more than [`AXIS_NORM_TOL`].
+    NotUnit {
+        /// The vector's length.
+        norm: f64,
+    },
+}
+
+impl fmt::Display for AxisError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            AxisError::NotFinite => f.write_str("tool axis (i,j,k) has a non-finite component"),
+            AxisError::Zero => f.write_str("tool axis (i,j,k) is the zero vector"),
+            AxisError::NotUnit { norm } => write!(
+                f,
+                "tool axis (i,j,k) has length {norm}, expected 1 within {AXIS_NORM_TOL}"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for AxisError {}
+
+/// The (phi1, phi2) solutions of one tool axis.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum AxisAngles {
+    /// Two solutions: orientation 1 = (phi1, phi2) with phi1 in (0, pi), and orientation 2 =
+    /// (-phi1, phi2 + pi); both phi2 in (-pi, pi].
+    Regular([ToolAngles; 2]),
+    /// The axis is within [`ROTARY_SINGULAR_CONE_RAD`] of the table normal (`phi1_abs` = 0) or
+    /// of its opposite (`phi1_abs` = pi): phi2 is undetermined. Pick phi2 (the previous row's
+    /// -theta2) and get phi1 from [`phi1_at`].
+    NearRotary {
+        /// |phi1| of the axis: its angle from the table normal (rad).
+        phi1_abs: f64,
+    },
+}
+
+/// The tool axis (unit, tip towards spindle, in R_t) for angles (phi1, phi2): eq. (8).
+pub fn tool_axis(phi1: f64, phi2: f64) -> Vector3<f64> {
+    let (s1, c1) = phi1.sin_cos();
+    let (s2, c2) = phi2.sin_cos();
+    Vector3::new(s1 * s2, -s1 * c2, c1)
+}
+
+/// Checks and normalises a tool-axis vector.
+pub fn unit_axis(axis: &Vector3<f64>) -> Result<Vector3<f64>, AxisError> {
+    if !axis.iter().all(|v| v.is_finite()) {
+        return Err(AxisError::NotFinite);
+    }
+    let norm = axis.norm();
+    if norm == 0.0 {
+        return Err(AxisError::Zero);
+    }
+    if (norm - 1.0).abs() > AXIS_NORM_TOL {
+        return Err(AxisError::NotUnit { norm });
+    }
+    Ok(axis / norm)
+}
+
+/// Every (phi1, phi2) giving the tool axis, or the rotary singularity. The vector is checked and
+/// normalised by [`unit_axis`].
+pub fn axis_angles(axis: &Vector3<f64>) -> Result<AxisAngles, AxisError> {
+    let a = unit_axis(axis)?;
+    let r = a.x.hypot(a.y);
+    // atan2 keeps full accuracy near both poles, unlike acos(k).
+    let phi1 = r.atan2(a.z);
+    if phi1 < ROTARY_SINGULAR_CONE_RAD || PI - phi1 < ROTARY_SINGULAR_CONE_RAD {
+        return Ok(AxisAngles::NearRotary { phi1_abs: phi1 });
+    }
+    // (i, j) = sin(phi1) (sin phi2, -cos phi2).
+    let phi2 = a.x.atan2(-a.y);
+    Ok(AxisAngles::Regular([
+        ToolAngles { phi1, phi2 },
+        ToolAngles {
+            phi1: -phi1,
+            phi2: wrap_angle(phi2 + PI),
+        },
+    ]))
+}
+
+/// The phi1 whose axis, at the given phi2, is nearest the (unit) axis `a`: the signed tilt in the
+/// plane of azimuth phi2. Exact when phi2 is one of the axis's own solutions; used inside the
+/// rotary-singularity cone, where the achieved axis then differs from `a` by at most the cone.
+pub fn phi1_at(a: &Vector3<f64>, phi2: f64) -> f64 {
+    let (s2, c2) = phi2.sin_cos();
+    (a.x * s2 - a.y * c2).atan2(a.z)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn both_solutions_give_the_axis() {
+        for &(p1, p2) in &[(0.3, 0.0), (-0.7, 2.0), (1.2, -3.0), (3.0, 1.0)] {
+            let a = tool_axis(p1, p2);
+            let AxisAngles::Regular(sols) = axis_angles(&a).unwrap() else {
+                panic!("regular expected")
+            };
+            for s in sols {
+                assert!((tool_axis(s.phi1, s.phi2) - a).amax() < 1e-15);
+            }
+            assert!(sols[0].phi1 > 0.0 && sols[1].phi1 < 0.0);
+        }
+    }
+
+    #[test]
+    fn bad_vectors_are_rejected_and_near_unit_normalised() {
+        assert_eq!(axis_angles(&Vector3::zeros()), Err(AxisError::Zero));
+        assert!(matches!(
+            axis_angles(&Vector3::new(0.0, 0.0, 2.0)),
+            Err(AxisError::NotUnit { .. })
+        ));
+        assert!(matches!(
+            axis_angles(&Vector3::new(f64::NAN, 0.0, 1.0)),
+            Err(AxisError::NotFinite)
+        ));
+        assert!(matches!(
+            axis_angles(&Vector3::new(0.0, 0.0, 1.0002)),
+            Ok(AxisAngles::NearRotary { .. })
+        ));
+        assert!(matches!(
+            axis_angles(&Vector3::new(0.0, 0.0, -1.0)),
+            Ok(AxisAngles::NearRotary { .. })
+        ));
+    }
+}

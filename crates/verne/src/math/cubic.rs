@@ -1,0 +1,266 @@
+//! Real roots of a cubic on an interval, for the inverse kinematics' eq. (9) (IFToMM 2007): the
+//! method of [`crate::math::poly::roots_in`] (critical points split the interval into monotone
+//! pieces; a piece with a sign change holds exactly one root) with the critical points in closed
+//! form and each root found by Halley steps kept inside its bracket, started from the secant
+//! point instead of the midpoint. Close calls (a critical point within rounding of a double root
+//! of p', a leading coefficient within rounding of zero) go to the general routine.
+
+use arrayvec::ArrayVec;
+
+use crate::math::poly::{Root, push_unique, roots_in_with_error};
+
+/// The roots on one interval: at most three, plus critical points reported as touching.
+pub type CubicRoots = ArrayVec<Root, 8>;
+
+/// All real roots of `c[0] + c[1] x + c[2] x^2 + c[3] x^3` in [lo, hi], sorted, with the
+/// semantics of [`roots_in`](crate::math::poly::roots_in) (end points that are roots included, critical points where |p|
+/// is within its rounding error reported as touching).
+pub fn cubic_roots_in(c: &[f64; 4], lo: f64, hi: f64) -> CubicRoots {
+    cubic_roots_in_with_error(c, &[0.0; 4], lo, hi)
+}
+
+/// [`cubic_roots_in`] where coefficient i may be off by `err[i]`: its decisions (a sign change,
+/// a critical point touching zero) hold for the exact cubic.
+pub fn cubic_roots_in_with_error(c: &[f64; 4], err: &[f64; 4], lo: f64, hi: f64) -> CubicRoots {
+    let scale = c.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+    // p' = 3 c3 x^2 + 2 c2 x + c1: closed form unless it is (nearly) linear or (nearly) a square.
+    let (a, b, k) = (3.0 * c[3], 2.0 * c[2], c[1]);
+    let disc = b * b - 4.0 * a * k;
+    let rounding = 16.0 * f64::EPSILON * (b * b + (4.0 * a * k).abs());
+    if c[3].abs() <= 1e-8 * scale
+        || disc.abs() <= rounding
+        || !disc.is_finite()
+        || lo.partial_cmp(&hi) != Some(std::cmp::Ordering::Less)
+    {
+        return roots_in_with_error(c, err, lo, hi)
+            .into_iter()
+            .take(8)
+            .collect();
+    }
+    let mut crit = ArrayVec::<f64, 2>::new();
+    if disc > 0.0 {
+        let q = -0.5 * (b + b.signum() * disc.sqrt());
+        let (x1, x2) = (q / a, k / q);
+        let (x1, x2) = if x1 <= x2 { (x1, x2) } else { (x2, x1) };
+        crit.extend([x1, x2].into_iter().filter(|&x| x > lo && x < hi));
+    }
+    let mut out = CubicRoots::new();
+    let (mut xa, (mut fa, mut ea)) = (lo, eval_with_error(c, err, lo));
+    if fa.abs() <= ea {
+        out.push(Root {
+            x: lo,
+            touching: false,
+        });
+    }
+    for k in 0..=crit.len() {
+        let xb = if k < crit.len() { crit[k] } else { hi };
+        let (fb, eb) = eval_with_error(c, err, xb);
+        let b_zero = fb.abs() <= eb;
+        if fa.abs() > ea && !b_zero && (fa < 0.0) != (fb < 0.0) {
+            push_unique(&mut out, bracketed(c, xa, xb, fa, fb));
+        } else if b_zero {
+            push_unique(
+                &mut out,
+                Root {
+                    x: xb,
+                    touching: k < crit.len(),
+                },
+            );
+        }
+        (xa, fa, ea) = (xb, fb, eb);
+    }
+    out
+}
+
+/// p(x) and a bound on its error, as [`crate::math::poly::eval_with_coefficient_error`] for degree 3.
+#[inline]
+fn eval_with_error(c: &[f64; 4], err: &[f64; 4], x: f64) -> (f64, f64) {
+    let ax = x.abs();
+    let coef = ((err[3] * ax + err[2]) * ax + err[1]) * ax + err[0];
+    let p3 = c[3];
+    let p2 = p3 * x + c[2];
+    let p1 = p2 * x + c[1];
+    let p0 = p1 * x + c[0];
+    let bound = ((p3.abs() * ax + p2.abs()) * ax + p1.abs()) * ax + p0.abs();
+    (p0, bound * 16.0 * f64::EPSILON + coef)
+}
+
+/// The root of a cubic that is monotone on [a, b] with p(a), p(b) of opposite signs: Halley
+/// steps from the secant point, every step kept inside the shrinking bracket (bisection
+/// otherwise). Halley's error after a step d is about C d^3 (C from p's derivatives); the
+/// iteration ends when that is below rounding, or a step or the bracket reaches rounding level.
+fn bracketed(c: &[f64; 4], mut a: f64, mut b: f64, fa: f64, fb: f64) -> Root {
+    let a_neg = fa < 0.0;
+    let mut x = a + (b - a) * (fa / (fa - fb));
+    if !(x > a && x < b) {
+        x = 0.5 * (a + b);
+    }
+    for _ in 0..200 {
+        let f = ((c[3] * x + c[2]) * x + c[1]) * x + c[0];
+        if f == 0.0 {
+            break;
+        }
+        if (f < 0.0) == a_neg {
+            a = x;
+        } else {
+            b = x;
+        }
+        let d1 = (3.0 * c[3] * x + 2.0 * c[2]) * x + c[1];
+        let d2 = 6.0 * c[3] * x + 2.0 * c[2];
+        let step = 2.0 * f * d1 / (2.0 * d1 * d1 - f * d2);
+        let next = x - step;
+        let tiny = 2.0 * f64::EPSILON * x.abs().max(1e-300);
+        let inside = next > a && next < b && step.is_finite();
+        if !inside {
+            // Outside the bracket (or at its end, with f at rounding level): bisect.
+            if step.abs() <= tiny {
+                break;
+            }
+            x = 0.5 * (a + b);
+        } else {
+            x = next;
+            // error = (r2^2 / 4 + |r3| / 6) |step|^3 with r2 = p''/p', r3 = p'''/p', multiplied
+            // through by p'^2 (no division).
+            let s = step.abs();
+            let error_d1sq = (0.25 * d2 * d2 + (c[3] * d1).abs()) * (s * s * s);
+            if s <= tiny || error_d1sq <= 0.5 * f64::EPSILON * x.abs() * (d1 * d1) {
+                break;
+            }
+        }
+        if b - a <= f64::EPSILON * (a.abs() + b.abs()) {
+            break;
+        }
+    }
+    Root { x, touching: false }
+}
+
+/// How far (relative to the quadratic's largest coefficient, squared) the discriminant of a
+/// deflated cubic, and (absolute) its roots from the interval's ends, must be for
+/// [`deflated_roots_in`] to decide alone.
+const DEFLATED_DISC_MARGIN: f64 = 1e-6;
+const DEFLATED_END_MARGIN: f64 = 1e-9;
+
+/// The roots in (lo, hi) of `c[0] + c[1] x + c[2] x^2 + c[3] x^3` other than its known root `w`
+/// (outside [lo, hi]): the quadratic c / (x - w) in closed form, sorted. None when that is a close
+/// call (a discriminant near zero: a close pair or double root; a root near `lo` or `hi`), so
+/// that [`cubic_roots_in`] decides; a caller polishes the roots on its own equations (the
+/// deflation adds a rounding error of the order of `w`'s). At most two, in a list of
+/// [`CubicRoots`]' size, so that a caller that falls back on [`cubic_roots_in`] keeps one list
+/// type for both and takes this one as it is (no copy).
+#[inline]
+pub fn deflated_roots_in(c: &[f64; 4], w: f64, lo: f64, hi: f64) -> Option<ArrayVec<f64, 8>> {
+    // Synthetic division: c = (x - w) (a x^2 + b x + k) + remainder.
+    let a = c[3];
+    let b = c[2] + w * a;
+    let k = c[1] + w * b;
+    let scale = a.abs().max(b.abs()).max(k.abs());
+    if a.abs() <= 1e-8 * scale || !scale.is_finite() {
+        return None;
+    }
+    let disc = b * b - 4.0 * a * k;
+    let mut out = ArrayVec::new();
+    if disc.abs() <= DEFLATED_DISC_MARGIN * scale * scale {
+        return None;
+    }
+    if disc < 0.0 {
+        return Some(out);
+    }
+    let q = -0.5 * (b + b.signum() * disc.sqrt());
+    let (x1, x2) = (q / a, k / q);
+    for x in if x1 <= x2 { [x1, x2] } else { [x2, x1] } {
+        if (x - lo).abs() <= DEFLATED_END_MARGIN || (x - hi).abs() <= DEFLATED_END_MARGIN {
+            return None;
+        }
+        if x > lo && x < hi {
+            out.push(x);
+        }
+    }
+    Some(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::poly::roots_in;
+    use crate::math::test_rng::lcg;
+
+    fn from_roots(rs: [f64; 3], lead: f64) -> [f64; 4] {
+        let [r1, r2, r3] = rs;
+        [
+            -lead * r1 * r2 * r3,
+            lead * (r1 * r2 + r1 * r3 + r2 * r3),
+            -lead * (r1 + r2 + r3),
+            lead,
+        ]
+    }
+
+    /// Same roots as the general routine, to rounding, on random cubics and sub-intervals.
+    #[test]
+    fn agrees_with_the_general_routine() {
+        let mut unit = lcg(1);
+        for _ in 0..20_000 {
+            let rs = [2.4 * unit() - 1.2, 2.4 * unit() - 1.2, 2.4 * unit() - 1.2];
+            let c = from_roots(rs, if unit() < 0.5 { -1.0 } else { 0.3 });
+            let lo = -1.0 + 0.5 * unit();
+            let fast = cubic_roots_in(&c, lo, 1.0);
+            let slow = roots_in(&c, lo, 1.0);
+            assert_eq!(
+                fast.len(),
+                slow.len(),
+                "{rs:?} on [{lo}, 1]: {fast:?} vs {slow:?}"
+            );
+            for (f, g) in fast.iter().zip(&slow) {
+                assert!((f.x - g.x).abs() < 1e-9, "{rs:?}: {fast:?} vs {slow:?}");
+                assert_eq!(f.touching, g.touching, "{rs:?}: {fast:?} vs {slow:?}");
+                // As exact as the cubic allows: p there within twice its rounding error.
+                let (p, err) = eval_with_error(&c, &[0.0; 4], f.x);
+                assert!(p.abs() <= 2.0 * err, "{rs:?}: p({}) = {p:e} > {err:e}", f.x);
+            }
+        }
+    }
+
+    #[test]
+    fn close_pair_double_root_and_end_points() {
+        let got = cubic_roots_in(&from_roots([0.1, 0.1 + 1e-5, 0.5], 1.0), -1.0, 1.0);
+        assert_eq!(got.len(), 3, "{got:?}");
+        let got = cubic_roots_in(&from_roots([0.3, 0.3, -0.7], 1.0), -1.0, 1.0);
+        assert!(
+            got.iter().any(|r| (r.x - 0.3).abs() < 1e-7 && r.touching),
+            "{got:?}"
+        );
+        assert!(got.iter().any(|r| (r.x + 0.7).abs() < 1e-12), "{got:?}");
+        let got = cubic_roots_in(&from_roots([-1.0, 2.0, 0.25], 1.0), -1.0, 1.0);
+        assert_eq!(got.len(), 2, "{got:?}");
+        assert_eq!(got[0].x, -1.0);
+    }
+
+    /// The deflated roots are the isolator's, to rounding, whenever they decide.
+    #[test]
+    fn deflation_agrees_with_isolation() {
+        let mut unit = lcg(7);
+        let mut decided = 0;
+        for _ in 0..20_000 {
+            let w = 0.5 + 0.5 * unit();
+            let (r2, r3) = (2.4 * unit() - 1.2, 2.4 * unit() - 1.2);
+            let c = from_roots([w, r2, r3], 0.3 + unit());
+            let hi = 0.45;
+            let Some(fast) = deflated_roots_in(&c, w, -1.0, hi) else {
+                continue;
+            };
+            decided += 1;
+            let slow = cubic_roots_in(&c, -1.0, hi);
+            assert_eq!(
+                fast.len(),
+                slow.len(),
+                "{w} {r2} {r3}: {fast:?} vs {slow:?}"
+            );
+            for (f, g) in fast.iter().zip(&slow) {
+                assert!(
+                    (f - g.x).abs() < 1e-9,
+                    "{w} {r2} {r3}: {fast:?} vs {slow:?}"
+                );
+            }
+        }
+        assert!(decided > 19_000, "{decided}");
+    }
+}

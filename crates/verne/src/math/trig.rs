@@ -1,0 +1,1169 @@
+//! Trigonometric polynomials a0 + sum_k (a_k cos k x + b_k sin k x) of degree at most 4, their
+//! conversion to ordinary polynomials by the half-angle substitution t = tan(x/2), and the
+//! isolation of their real roots directly on the circle ([`Trig::roots`]).
+
+use arrayvec::ArrayVec;
+
+use crate::math::poly::Coeffs;
+
+/// sin and cos of `alpha` = a - d from those of a (a Newton step d): by the angle-difference
+/// formulas with the series of sin d and cos d (two terms for |d| < 1e-3, six up to 0.25: both
+/// exact in double precision), else by `sin_cos`.
+#[inline(always)]
+pub fn sin_cos_after_step(sin_a: f64, cos_a: f64, alpha: f64, d: f64) -> (f64, f64) {
+    let d2 = d * d;
+    let (sd, cd) = if d.abs() < 1e-3 {
+        (
+            d * (1.0 - d2 * (1.0 / 6.0) * (1.0 - d2 * (1.0 / 20.0))),
+            1.0 - d2 * 0.5 * (1.0 - d2 * (1.0 / 12.0)),
+        )
+    } else if d.abs() < SMALL_ANGLE {
+        sin_cos_small(d)
+    } else {
+        return alpha.sin_cos();
+    };
+    (sin_a * cd - cos_a * sd, cos_a * cd + sin_a * sd)
+}
+
+/// Largest |d| for [`sin_cos_small`].
+pub const SMALL_ANGLE: f64 = 0.25;
+
+/// sin d and cos d for |d| < [`SMALL_ANGLE`] by their series, without a branch. The next terms
+/// are below d^13 / 13! and d^14 / 14!: under 1e-17 relative for |d| < 0.25.
+#[inline(always)]
+pub fn sin_cos_small(d: f64) -> (f64, f64) {
+    let d2 = d * d;
+    let sd = d
+        * (1.0
+            - d2 * (1.0 / 6.0)
+                * (1.0
+                    - d2 * (1.0 / 20.0)
+                        * (1.0
+                            - d2 * (1.0 / 42.0)
+                                * (1.0 - d2 * (1.0 / 72.0) * (1.0 - d2 * (1.0 / 110.0))))));
+    let cd = 1.0
+        - d2 * 0.5
+            * (1.0
+                - d2 * (1.0 / 12.0)
+                    * (1.0
+                        - d2 * (1.0 / 30.0)
+                            * (1.0
+                                - d2 * (1.0 / 56.0)
+                                    * (1.0 - d2 * (1.0 / 90.0) * (1.0 - d2 * (1.0 / 132.0))))));
+    (sd, cd)
+}
+
+/// Highest harmonic kept.
+pub const MAX_HARMONIC: usize = 4;
+
+/// `cos[k]`, `sin[k]` are the coefficients of cos(k x) and sin(k x); `sin[0]` is unused (0).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Trig {
+    pub cos: [f64; MAX_HARMONIC + 1],
+    pub sin: [f64; MAX_HARMONIC + 1],
+}
+
+impl Trig {
+    /// a0 + ac cos x + as sin x.
+    pub const fn linear(a0: f64, ac: f64, a_s: f64) -> Trig {
+        Trig {
+            cos: [a0, ac, 0.0, 0.0, 0.0],
+            sin: [0.0, a_s, 0.0, 0.0, 0.0],
+        }
+    }
+
+    pub fn degree(&self) -> usize {
+        (0..=MAX_HARMONIC)
+            .rev()
+            .find(|&k| self.cos[k] != 0.0 || self.sin[k] != 0.0)
+            .unwrap_or(0)
+    }
+
+    pub fn eval(&self, x: f64) -> f64 {
+        let (s1, c1) = x.sin_cos();
+        self.eval_sc(s1, c1)
+    }
+
+    /// The value at x from (sin x, cos x).
+    #[inline]
+    pub fn eval_sc(&self, s1: f64, c1: f64) -> f64 {
+        self.eval_sc_up_to(s1, c1, MAX_HARMONIC)
+    }
+
+    /// [`Trig::eval_sc`] of a form of degree at most `D` (the terms left out are zero: the same
+    /// value).
+    #[inline]
+    pub fn eval_sc_deg<const D: usize>(&self, s1: f64, c1: f64) -> f64 {
+        debug_assert!(self.degree() <= D);
+        self.eval_sc_up_to(s1, c1, D.min(MAX_HARMONIC))
+    }
+
+    #[inline(always)]
+    fn eval_sc_up_to(&self, s1: f64, c1: f64, degree: usize) -> f64 {
+        let (mut ck, mut sk) = (1.0, 0.0);
+        let mut acc = self.cos[0];
+        for k in 1..=degree {
+            let c = ck * c1 - sk * s1;
+            sk = sk * c1 + ck * s1;
+            ck = c;
+            acc += self.cos[k] * ck + self.sin[k] * sk;
+        }
+        acc
+    }
+
+    pub fn add(&self, o: &Trig) -> Trig {
+        let mut r = *self;
+        for k in 0..=MAX_HARMONIC {
+            r.cos[k] += o.cos[k];
+            r.sin[k] += o.sin[k];
+        }
+        r
+    }
+
+    pub fn scale(&self, f: f64) -> Trig {
+        let mut r = *self;
+        for k in 0..=MAX_HARMONIC {
+            r.cos[k] *= f;
+            r.sin[k] *= f;
+        }
+        r
+    }
+
+    /// The product; the caller guarantees the degrees add up to at most [`MAX_HARMONIC`].
+    pub fn mul(&self, o: &Trig) -> Trig {
+        self.mul_up_to(o, self.degree(), o.degree())
+    }
+
+    /// [`Trig::mul`] of a form of degree at most `DA` by one of degree at most `DB`, with the
+    /// loops fixed at compile time (the same sums in the same order: the same result).
+    #[inline]
+    pub fn mul_deg<const DA: usize, const DB: usize>(&self, o: &Trig) -> Trig {
+        const { assert!(DA + DB <= MAX_HARMONIC) };
+        debug_assert!(self.degree() <= DA && o.degree() <= DB);
+        self.mul_up_to(o, DA, DB)
+    }
+
+    #[inline(always)]
+    fn mul_up_to(&self, o: &Trig, da: usize, db: usize) -> Trig {
+        debug_assert!(da + db <= MAX_HARMONIC);
+        let mut r = Trig::default();
+        for j in 0..=da {
+            let (aj, bj) = (self.cos[j], self.sin[j]);
+            for k in 0..=db {
+                let (ak, bk) = (o.cos[k], o.sin[k]);
+                let sum = j + k;
+                let diff = j.abs_diff(k);
+                // cos j cos k = (cos(j-k) + cos(j+k)) / 2
+                r.cos[sum] += 0.5 * aj * ak;
+                r.cos[diff] += 0.5 * aj * ak;
+                // sin j sin k = (cos(j-k) - cos(j+k)) / 2
+                r.cos[diff] += 0.5 * bj * bk;
+                r.cos[sum] -= 0.5 * bj * bk;
+                // sin j cos k = (sin(j+k) + sin(j-k)) / 2
+                r.sin[sum] += 0.5 * bj * ak;
+                r.sin[sum] += 0.5 * aj * bk;
+                if j >= k {
+                    r.sin[diff] += 0.5 * bj * ak;
+                    r.sin[diff] -= 0.5 * aj * bk;
+                } else {
+                    r.sin[diff] -= 0.5 * bj * ak;
+                    r.sin[diff] += 0.5 * aj * bk;
+                }
+            }
+        }
+        r.sin[0] = 0.0;
+        r
+    }
+
+    /// The derivative d/dx.
+    pub fn derivative(&self) -> Trig {
+        let mut r = Trig::default();
+        for k in 1..=MAX_HARMONIC {
+            r.cos[k] = k as f64 * self.sin[k];
+            r.sin[k] = -(k as f64) * self.cos[k];
+        }
+        r
+    }
+
+    /// sum_k k^order |(a_k, b_k)|: a bound on |d^order p / dx^order| over the circle.
+    fn harmonic_bound(&self, order: i32) -> f64 {
+        let b: f64 = (1..=MAX_HARMONIC)
+            .map(|k| {
+                let (a, b) = (self.cos[k], self.sin[k]);
+                (k as f64).powi(order) * (a * a + b * b).sqrt()
+            })
+            .sum();
+        b * (1.0 + 1e-12)
+    }
+
+    /// |a0| + sum_k (|a_k| + |b_k|), scaled to bound the rounding error of evaluating p (a sum
+    /// of nine products of cosines and sines accurate to a few units in the last place, at a
+    /// point representable to half a unit of pi).
+    fn eval_error(&self) -> f64 {
+        let abs: f64 = self.cos[0].abs()
+            + (1..=MAX_HARMONIC)
+                .map(|k| self.cos[k].abs() + self.sin[k].abs())
+                .sum::<f64>();
+        64.0 * f64::EPSILON * abs
+    }
+
+    /// p at the grid points x_j.
+    /// The value at grid point j, as [`Trig::on_grid`] computes it (same sums, same order).
+    #[inline]
+    fn at_grid(&self, j: usize) -> f64 {
+        let mut v = self.cos[0];
+        for k in 0..MAX_HARMONIC {
+            v += self.cos[k + 1] * GRID_COS[k][j] + self.sin[k + 1] * GRID_SIN[k][j];
+        }
+        v
+    }
+
+    #[inline(always)]
+    fn on_grid(&self) -> [f64; GRID] {
+        let mut v = [self.cos[0]; GRID];
+        for k in 0..MAX_HARMONIC {
+            let (a, b) = (self.cos[k + 1], self.sin[k + 1]);
+            for (j, vj) in v.iter_mut().enumerate() {
+                *vj += a * GRID_COS[k][j] + b * GRID_SIN[k][j];
+            }
+        }
+        v
+    }
+
+    /// Every real root in [-pi, pi], each once (a root at +-pi as -pi), in increasing order;
+    /// at a double root or a pair of roots too close to separate in floating point, one
+    /// candidate. Empty when p is identically zero or not finite.
+    ///
+    /// Complete by construction: F, F', F'' are sampled on a grid of 32 points and every grid
+    /// interval is either proved root-free, proved monotone (its one root, if F changes sign, is
+    /// found by bracketed Chebyshev steps, Newton's corrected by F''), proved convex or concave
+    /// (split at its critical point into two monotone pieces), or bisected (see
+    /// `Isolation::interval`). This replaces the degree-8 half-angle polynomials of IFToMM 2007
+    /// section VI for the forward kinematics (one pass over the circle, no chart at alpha = pi,
+    /// no recursion on derivatives).
+    pub fn roots(&self) -> ArrayVec<f64, MAX_TRIG_ROOTS> {
+        self.roots_sin_cos().iter().map(|r| r.x).collect()
+    }
+
+    /// [`Trig::roots`], each with its sine and cosine (carried along the root finding). Built
+    /// with AVX2 where the processor has it ([`crate::math::cpu`]).
+    pub fn roots_sin_cos(&self) -> ArrayVec<TrigRoot, MAX_TRIG_ROOTS> {
+        #[cfg(target_arch = "x86_64")]
+        if crate::math::cpu::has_avx2() {
+            // SAFETY: the processor has AVX2 (checked just above).
+            return unsafe { roots_sin_cos_avx2(self) };
+        }
+        self.roots_sin_cos_built::<false>()
+    }
+
+    /// [`Trig::roots_sin_cos`] built for the x86-64 baseline whatever the processor has: the
+    /// same roots, bit for bit.
+    #[doc(hidden)]
+    pub fn roots_sin_cos_baseline(&self) -> ArrayVec<TrigRoot, MAX_TRIG_ROOTS> {
+        self.roots_sin_cos_built::<false>()
+    }
+
+    /// The body of [`Trig::roots_sin_cos`], inlined into each build (`AVX2` tells them apart:
+    /// see [`crate::math::cpu`]).
+    #[inline(always)]
+    pub(crate) fn roots_sin_cos_built<const AVX2: bool>(
+        &self,
+    ) -> ArrayVec<TrigRoot, MAX_TRIG_ROOTS> {
+        self.isolate_built::<AVX2>(0.0, false).roots
+    }
+
+    /// Every real root in [-pi, pi] that can be proved, and the intervals where none can be
+    /// proved or excluded in double precision ([`Isolated`]). `coef_err` bounds the error of
+    /// the coefficients themselves (|p(x) - exact(x)| <= coef_err for every x, from the rounding
+    /// of the formulas that computed them): the proofs hold for the exact polynomial. Built with
+    /// AVX2 where the processor has it ([`crate::math::cpu`]).
+    pub fn roots_certified(&self, coef_err: f64) -> Isolated {
+        #[cfg(target_arch = "x86_64")]
+        if crate::math::cpu::has_avx2() {
+            // SAFETY: the processor has AVX2 (checked just above).
+            return unsafe { roots_certified_avx2(self, coef_err) };
+        }
+        self.isolate_built::<false>(coef_err, true)
+    }
+
+    /// The body of [`Trig::roots_sin_cos`] and [`Trig::roots_certified`], inlined into each
+    /// build. With `certify`, an interval no test decides is returned as ambiguous instead of
+    /// handed to the half-angle charts.
+    #[inline(always)]
+    pub(crate) fn isolate_built<const AVX2: bool>(&self, coef_err: f64, certify: bool) -> Isolated {
+        let scale = self
+            .cos
+            .iter()
+            .chain(&self.sin)
+            .fold(0.0f64, |m, a| m.max(a.abs()));
+        if scale == 0.0 || !scale.is_finite() || !coef_err.is_finite() {
+            let mut out = Isolated::default();
+            if certify && !(scale == 0.0 && coef_err == 0.0) {
+                // Not finite, or zero only within the coefficients' error: nothing is proved.
+                out.ambiguous
+                    .push([-std::f64::consts::PI, std::f64::consts::PI]);
+            }
+            return out;
+        }
+        let f = self.scale(1.0 / scale);
+        let d = f.derivative();
+        let s = d.derivative();
+        // The coefficients' own error moves p by at most `ce`, p' by 4 ce, p'' by 16 ce, ...
+        // (each harmonic k scales by k per derivative): every bound below covers the exact
+        // polynomial as well as the computed one.
+        let ce = coef_err / scale;
+        let mut iso = Isolation {
+            f,
+            d,
+            s,
+            m2: s.harmonic_bound(0) + 16.0 * ce,
+            m3: s.harmonic_bound(1) + 64.0 * ce,
+            m4: s.harmonic_bound(2) + 256.0 * ce,
+            ef: f.eval_error() + ce,
+            ed: d.eval_error() + 4.0 * ce,
+            es: s.eval_error() + 16.0 * ce,
+            out: ArrayVec::new(),
+            orig: *self,
+            charts: [None, None],
+            ambiguous: certify.then(ArrayVec::new),
+        };
+        // F on the whole grid; F' and F'' only at the ends of the intervals that F alone does not
+        // prove root-free (few: about two per root).
+        let fv = f.on_grid();
+        let step = std::f64::consts::PI / 16.0;
+        let pt = |j: usize| Pt {
+            x: (j as f64 - 16.0) * step,
+            sin: GRID_SIN[0][j % GRID],
+            cos: GRID_COS[0][j % GRID],
+            f: fv[j % GRID],
+            d: d.at_grid(j % GRID),
+            s: s.at_grid(j % GRID),
+        };
+        // Intervals that F alone does not prove root-free, as a bit mask: bit j of `above`
+        // (`below`) when F(x_j) is beyond the bound above (below) zero, and interval j (x_j to
+        // x_j+1, around the circle) proved root-free when both its ends are. F is finite on
+        // the grid, so these plain comparisons say what `same_sign_beyond` says.
+        let root_free = step * step * 0.125 * iso.m2 + iso.ef;
+        const _: () = assert!(GRID == u32::BITS as usize);
+        let (mut above, mut below) = (0u32, 0u32);
+        for (j, v) in fv.iter().enumerate() {
+            above |= u32::from(*v > root_free) << j;
+            below |= u32::from(*v < -root_free) << j;
+        }
+        let free = (above & above.rotate_right(1)) | (below & below.rotate_right(1));
+        let mut undecided = !free;
+        while undecided != 0 {
+            let j = undecided.trailing_zeros() as usize;
+            undecided &= undecided - 1;
+            let (a, b) = (pt(j), pt(j + 1));
+            let found = iso.out.len();
+            let near_zero = a.f.abs() <= iso.ef || b.f.abs() <= iso.ef;
+            if near_zero && iso.ambiguous.is_some() {
+                iso.give_up(a.x, b.x);
+            } else if near_zero || iso.interval::<AVX2>(a, b, 0).is_none() {
+                iso.out.truncate(found);
+                iso.chart_roots(a.x, b.x);
+            }
+        }
+        let ambiguous = iso.ambiguous.unwrap_or_default();
+        let mut roots = iso.out;
+        // A full list of ambiguous intervals grows its last one over what follows: the roots
+        // found there are the caller's to find again.
+        roots.retain(|r| !ambiguous.iter().any(|[lo, hi]| r.x >= *lo && r.x <= *hi));
+        Isolated { roots, ambiguous }
+    }
+
+    /// (1 + t^2)^4 p(x) as a polynomial in t = tan((x - shift)/2), shift in {0, pi}: the
+    /// half-angle substitution of IFToMM 2007 section VI. With shift = pi the chart covers
+    /// x near pi, where t = tan(x/2) would be infinite.
+    pub fn to_half_angle_poly(&self, shift_pi: bool) -> Coeffs {
+        let mut out = Coeffs::new();
+        for _ in 0..=2 * MAX_HARMONIC {
+            out.push(0.0);
+        }
+        for k in 0..=MAX_HARMONIC {
+            let sign = if shift_pi && k % 2 == 1 { -1.0 } else { 1.0 };
+            for i in 0..=2 * MAX_HARMONIC {
+                out[i] += sign
+                    * (self.cos[k] * HALF_ANGLE_COS[k][i] + self.sin[k] * HALF_ANGLE_SIN[k][i]);
+            }
+        }
+        out
+    }
+}
+
+/// A root x of a trigonometric polynomial with sin x and cos x.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrigRoot {
+    pub x: f64,
+    pub sin: f64,
+    pub cos: f64,
+}
+
+/// Most intervals [`Trig::roots_certified`] leaves undecided (each holds a close pair or
+/// a multiple root; more would only come from a polynomial that is zero within rounding).
+pub const MAX_AMBIGUOUS: usize = 4;
+
+/// What [`Trig::roots_certified`] proves: the roots it isolated (each simple, each proved to be
+/// the only root of the exact polynomial in an interval where the polynomial changes sign), in
+/// increasing order, and the intervals [lo, hi] it could neither prove root-free nor isolate
+/// (closed, disjoint, in increasing order; the roots are outside them). Every other point of
+/// [-pi, pi] is proved not to be a root.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Isolated {
+    pub roots: ArrayVec<TrigRoot, MAX_TRIG_ROOTS>,
+    pub ambiguous: ArrayVec<[f64; 2], MAX_AMBIGUOUS>,
+}
+
+/// Most roots [`Trig::roots`] returns: 2 [`MAX_HARMONIC`] simple roots, plus candidates at
+/// near-double roots.
+pub const MAX_TRIG_ROOTS: usize = 32;
+
+/// Grid of the root isolation: x_j = -pi + j pi / 16, j = 0..32.
+const GRID: usize = 32;
+
+/// cos(m pi / 16), m = 0..=8, correctly rounded.
+const COS_OCTANTS: [f64; 9] = [
+    1.0,
+    0.980_785_280_403_230_4,
+    0.923_879_532_511_286_7,
+    0.831_469_612_302_545_2,
+    std::f64::consts::FRAC_1_SQRT_2,
+    0.555_570_233_019_602_2,
+    0.382_683_432_365_089_8,
+    0.195_090_322_016_128_28,
+    0.0,
+];
+
+/// cos(m pi / 16) for any m, by symmetry from the first quadrant (exact table entries).
+const fn grid_cos(m: usize) -> f64 {
+    let m = m % GRID;
+    match m / 8 {
+        0 => COS_OCTANTS[m],
+        1 => -COS_OCTANTS[16 - m],
+        2 => -COS_OCTANTS[m - 16],
+        _ => COS_OCTANTS[32 - m],
+    }
+}
+
+/// cos(k x_j) (`sin == false`) or sin(k x_j) on the grid, k = 1..=4 (row k - 1).
+const fn grid_table(sin: bool) -> [[f64; GRID]; MAX_HARMONIC] {
+    let mut t = [[0.0; GRID]; MAX_HARMONIC];
+    let mut k = 1;
+    while k <= MAX_HARMONIC {
+        let mut j = 0;
+        while j < GRID {
+            // k x_j = (k j - 16 k) pi / 16; sin(y) = cos(y - pi / 2).
+            let m = k * j + 4 * GRID - 16 * k + if sin { 3 * GRID / 4 } else { 0 };
+            t[k - 1][j] = grid_cos(m);
+            j += 1;
+        }
+        k += 1;
+    }
+    t
+}
+
+const GRID_COS: [[f64; GRID]; MAX_HARMONIC] = grid_table(false);
+const GRID_SIN: [[f64; GRID]; MAX_HARMONIC] = grid_table(true);
+
+/// Bisection depth at which an interval that no test decides (a root of multiplicity three or
+/// more, within rounding) is given up and its midpoint reported as a candidate.
+const MAX_DEPTH: u32 = 40;
+
+/// A point with sin and cos of it and the values of F, F' and F'' there.
+#[derive(Debug, Clone, Copy)]
+struct Pt {
+    x: f64,
+    sin: f64,
+    cos: f64,
+    f: f64,
+    d: f64,
+    s: f64,
+}
+
+/// Both values beyond t on the same side of zero.
+#[inline]
+fn same_sign_beyond(u: f64, v: f64, t: f64) -> bool {
+    u.min(v) > t || u.max(v) < -t
+}
+
+/// Both values beyond t, on opposite sides of zero.
+#[inline]
+fn opposite_beyond(u: f64, v: f64, t: f64) -> bool {
+    u.abs() > t && v.abs() > t && (u < 0.0) != (v < 0.0)
+}
+
+/// Root isolation state for one normalised F (see [`Trig::roots`]).
+struct Isolation {
+    f: Trig,
+    d: Trig,
+    s: Trig,
+    /// Bounds on |F''|, |F'''|, |F''''| over the whole circle.
+    m2: f64,
+    m3: f64,
+    m4: f64,
+    /// Bounds on the rounding errors of evaluating F, F', F''.
+    ef: f64,
+    ed: f64,
+    es: f64,
+    out: ArrayVec<TrigRoot, MAX_TRIG_ROOTS>,
+    /// The polynomial as given, and its half-angle charts (computed when needed).
+    orig: Trig,
+    charts: [Option<Coeffs>; 2],
+    /// In certifying mode ([`Trig::roots_certified`]), the intervals given up on.
+    ambiguous: Option<ArrayVec<[f64; 2], MAX_AMBIGUOUS>>,
+}
+
+impl Isolation {
+    /// F, F', F'' at x (one sin_cos; cos k x, sin k x by the angle-sum recurrence).
+    #[inline(always)]
+    fn at(&self, x: f64) -> Pt {
+        let (s1, c1) = x.sin_cos();
+        self.at_sc(x, s1, c1)
+    }
+
+    /// sin and cos of x along a root iteration: from those of the previous point when it is
+    /// close ([`sin_cos_after_step`]), kept in `last`.
+    #[inline(always)]
+    fn sin_cos_following(x: f64, last: &std::cell::Cell<Option<(f64, f64, f64)>>) -> (f64, f64) {
+        let (s1, c1) = match last.get() {
+            Some((x0, s0, c0)) => sin_cos_after_step(s0, c0, x, x0 - x),
+            None => x.sin_cos(),
+        };
+        last.set(Some((x, s1, c1)));
+        (s1, c1)
+    }
+
+    /// [`Isolation::at`] along a root iteration ([`Isolation::sin_cos_following`]).
+    #[inline(always)]
+    fn at_following(&self, x: f64, last: &std::cell::Cell<Option<(f64, f64, f64)>>) -> Pt {
+        let (s1, c1) = Self::sin_cos_following(x, last);
+        self.at_sc(x, s1, c1)
+    }
+
+    /// g and h (two of F, F', F'') at x along a root iteration, without the third.
+    #[inline(always)]
+    fn pair_following(
+        x: f64,
+        last: &std::cell::Cell<Option<(f64, f64, f64)>>,
+        g: &Trig,
+        h: &Trig,
+    ) -> (f64, f64) {
+        let (s1, c1) = Self::sin_cos_following(x, last);
+        let (c, s) = harmonics(s1, c1);
+        (dot_harmonics(g, &c, &s), dot_harmonics(h, &c, &s))
+    }
+
+    #[inline(always)]
+    fn at_sc(&self, x: f64, s1: f64, c1: f64) -> Pt {
+        let (c, s) = harmonics(s1, c1);
+        Pt {
+            x,
+            sin: s1,
+            cos: c1,
+            f: dot_harmonics(&self.f, &c, &s),
+            d: dot_harmonics(&self.d, &c, &s),
+            s: dot_harmonics(&self.s, &c, &s),
+        }
+    }
+
+    fn push(&mut self, x: f64, (sin, cos): (f64, f64)) {
+        if !self.out.is_full() {
+            self.out.push(TrigRoot { x, sin, cos });
+        }
+    }
+
+    /// Every root in [a.x, b.x] (F beyond rounding at both ends), or None where F comes within
+    /// rounding of zero inside (a double root or a pair of roots too close for the trigonometric
+    /// form: the caller hands the interval to [`Isolation::chart_roots`]).
+    /// With h = b.x - a.x, a function g with |g''| <= M on the interval stays within h^2 M / 8 of
+    /// its chord: when both end values are beyond that (plus rounding) on the same side of zero,
+    /// g has no zero there. Applied to F (no root), F' (F strictly monotone: one root at most,
+    /// exactly where F changes sign) and F'' (F' strictly monotone: at most one critical point,
+    /// which splits the interval into two monotone pieces). Intervals none of these decides are
+    /// bisected; the bounds shrink four times per bisection, so only the neighbourhood of a triple
+    /// root can reach [`MAX_DEPTH`]. Runs in the build `AVX2` names ([`crate::math::cpu`]), through
+    /// a function of its own, so that its recursion stays in the build it started in.
+    #[inline(always)]
+    fn interval<const AVX2: bool>(&mut self, a: Pt, b: Pt, depth: u32) -> Option<()> {
+        #[cfg(target_arch = "x86_64")]
+        if AVX2 {
+            // SAFETY: AVX2 is true only below `roots_sin_cos_avx2`, which runs where the
+            // processor has AVX2.
+            return unsafe { interval_avx2(self, a, b, depth) };
+        }
+        interval_baseline(self, a, b, depth)
+    }
+
+    /// The body of [`Isolation::interval`], inlined into each build; its recursion goes back
+    /// through the dispatch, into the same build.
+    #[inline(always)]
+    fn interval_built<const AVX2: bool>(&mut self, a: Pt, b: Pt, depth: u32) -> Option<()> {
+        let h = b.x - a.x;
+        let w = h * h * 0.125;
+        if same_sign_beyond(a.f, b.f, w * self.m2 + self.ef) {
+            return Some(());
+        }
+        if same_sign_beyond(a.d, b.d, w * self.m3 + self.ed) {
+            self.monotone::<AVX2>(a, b);
+            return Some(());
+        }
+        if same_sign_beyond(a.s, b.s, w * self.m4 + self.es) {
+            if opposite_beyond(a.d, b.d, self.ed) {
+                // F is convex or concave here: a point where F is beyond rounding on the other
+                // side of zero from both ends splits [a, b] into two pieces with one simple root
+                // each. The estimate of the critical point usually is one (two close assembly
+                // modes); otherwise the critical point itself decides.
+                let guess = hermite_start(a.x, b.x, a.d, b.d, a.s, b.s);
+                let (sg, cg) = sin_cos_after_step(a.sin, a.cos, guess, a.x - guess);
+                let g = self.at_sc(guess, sg, cg);
+                let splits =
+                    opposite_beyond(g.f, a.f, self.ef) && opposite_beyond(g.f, b.f, self.ef);
+                let c = if splits {
+                    g
+                } else {
+                    self.critical::<AVX2>(a, b)
+                };
+                if c.f.abs() <= self.ef {
+                    // Outside certifying mode the caller hands the interval to the charts.
+                    self.ambiguous.as_ref()?;
+                    // Only near c can F come within rounding of zero (two close roots, or a
+                    // double one): the rest of [a, b] is proved root-free.
+                    let (lo, hi) = self.band_around(a, c, b);
+                    return self.give_up(lo, hi);
+                }
+                self.monotone::<AVX2>(a, c);
+                self.monotone::<AVX2>(c, b);
+                return Some(());
+            } else if self.ambiguous.is_none() || same_sign_beyond(a.d, b.d, self.ed) {
+                // F' monotone and not changing sign beyond rounding: F monotone. (Where an end
+                // of F' is within rounding of zero, F could turn there: a proof bisects.)
+                self.monotone::<AVX2>(a, b);
+                return Some(());
+            }
+        }
+        let mut m = self.at(0.5 * (a.x + b.x));
+        if m.f.abs() <= self.ef && self.ambiguous.is_some() {
+            // A proof needs split points where F is beyond rounding: try off-centre ones.
+            for frac in [0.3, 0.7] {
+                let p = self.at(a.x + frac * (b.x - a.x));
+                if p.f.abs() > self.ef {
+                    m = p;
+                    break;
+                }
+            }
+        }
+        if depth >= MAX_DEPTH || m.f.abs() <= self.ef {
+            return self.give_up(a.x, b.x);
+        }
+        self.interval::<AVX2>(a, m, depth + 1)?;
+        self.interval::<AVX2>(m, b, depth + 1)
+    }
+
+    /// F monotone on [a, c] and on [c, b] (c its critical point, within rounding of zero; a and b
+    /// beyond it): the interval around c outside which F is proved beyond rounding, so root-free.
+    /// Found by stepping out from c by the distance at which F's quadratic model leaves the
+    /// rounding band, four times farther each try.
+    #[cold]
+    fn band_around(&self, a: Pt, c: Pt, b: Pt) -> (f64, f64) {
+        let r0 = (4.0 * self.ef / c.s.abs().max(f64::MIN_POSITIVE)).sqrt();
+        let side = |end: Pt, dir: f64| {
+            let mut r = r0;
+            while r < (end.x - c.x).abs() {
+                let p = self.at(c.x + dir * r);
+                if p.f.abs() > self.ef && (p.f < 0.0) == (end.f < 0.0) {
+                    return p.x;
+                }
+                r *= 4.0;
+            }
+            end.x
+        };
+        (side(a, -1.0), side(b, 1.0))
+    }
+
+    /// No test decides [xa, xb]: in certifying mode it is recorded as ambiguous (and the search
+    /// goes on elsewhere); otherwise None, and the caller hands the grid interval to the charts.
+    #[cold]
+    fn give_up(&mut self, xa: f64, xb: f64) -> Option<()> {
+        let amb = self.ambiguous.as_mut()?;
+        let full = amb.is_full();
+        match amb.last_mut() {
+            // Adjacent pieces (a bisection that gave up on both halves) make one interval; with
+            // the list full, the last one grows over the rest.
+            Some(last) if last[1] >= xa || full => last[1] = last[1].max(xb),
+            _ => amb.push([xa, xb]),
+        }
+        Some(())
+    }
+
+    /// The roots in [xa, xb] (inside [-pi/2, pi/2] or outside it) from the half-angle chart that
+    /// covers it (IFToMM 2007 section VI), by `poly::roots_in`, whose Horner evaluation near the
+    /// chart's centre (alpha = 0 or pi, where the close pairs of assembly modes occur) is accurate
+    /// relative to the size of F there, not to its coefficients.
+    fn chart_roots(&mut self, xa: f64, xb: f64) {
+        use std::f64::consts::{FRAC_PI_2, PI};
+        let shift = xa < -FRAC_PI_2 || xb > FRAC_PI_2;
+        let k = usize::from(shift);
+        let poly = self.charts[k].get_or_insert_with(|| {
+            let mut poly = self.orig.to_half_angle_poly(shift);
+            let scale = poly.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+            for a in poly.iter_mut() {
+                *a /= scale;
+            }
+            poly
+        });
+        let centre = if !shift {
+            0.0
+        } else if xa < 0.0 {
+            -PI
+        } else {
+            PI
+        };
+        let t = |x: f64| (0.5 * (x - centre)).tan();
+        let (lo, hi) = ((t(xa) - 1e-12).max(-1.0), (t(xb) + 1e-12).min(1.0));
+        for r in crate::math::poly::roots_in(poly, lo, hi) {
+            let x = 2.0 * r.x.atan() + centre;
+            self.push(x, x.sin_cos());
+        }
+    }
+
+    /// F monotone on [a.x, b.x], or convex or concave there with one simple root: its root there
+    /// when F changes sign beyond rounding.
+    #[inline(always)]
+    fn monotone<const AVX2: bool>(&mut self, a: Pt, b: Pt) {
+        if opposite_beyond(a.f, b.f, self.ef) {
+            let start = root_start(a, b);
+            let last = std::cell::Cell::new(Some((a.x, a.sin, a.cos)));
+            let bounds = StepBounds {
+                m2: self.m2,
+                m3: Some(self.m3),
+            };
+            let x = newton_bracketed(
+                a.x,
+                b.x,
+                a.f,
+                start,
+                bounds,
+                #[inline(always)]
+                |x| {
+                    let p = self.at_following(x, &last);
+                    (p.f, p.d, p.s)
+                },
+            );
+            self.push(x, Self::sin_cos_following(x, &last));
+        }
+    }
+
+    /// The single root of F' on [a.x, b.x] (F' strictly monotone, changing sign), with F there.
+    #[inline(always)]
+    fn critical<const AVX2: bool>(&self, a: Pt, b: Pt) -> Pt {
+        let start = hermite_start(a.x, b.x, a.d, b.d, a.s, b.s);
+        let last = std::cell::Cell::new(Some((a.x, a.sin, a.cos)));
+        let bounds = StepBounds {
+            m2: self.m3,
+            m3: None,
+        };
+        let x = newton_bracketed(
+            a.x,
+            b.x,
+            a.d,
+            start,
+            bounds,
+            #[inline(always)]
+            |x| {
+                let (g, dg) = Self::pair_following(x, &last, &self.d, &self.s);
+                (g, dg, 0.0)
+            },
+        );
+        self.at_following(x, &last)
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn roots_sin_cos_avx2(t: &Trig) -> ArrayVec<TrigRoot, MAX_TRIG_ROOTS> {
+    t.roots_sin_cos_built::<true>()
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn roots_certified_avx2(t: &Trig, coef_err: f64) -> Isolated {
+    t.isolate_built::<true>(coef_err, true)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn interval_avx2(iso: &mut Isolation, a: Pt, b: Pt, depth: u32) -> Option<()> {
+    iso.interval_built::<true>(a, b, depth)
+}
+
+fn interval_baseline(iso: &mut Isolation, a: Pt, b: Pt, depth: u32) -> Option<()> {
+    iso.interval_built::<false>(a, b, depth)
+}
+
+/// cos k x and sin k x, k = 1..=4, from sin x and cos x (angle-sum recurrences).
+#[inline]
+fn harmonics(s1: f64, c1: f64) -> ([f64; MAX_HARMONIC], [f64; MAX_HARMONIC]) {
+    let (c2, s2) = (c1 * c1 - s1 * s1, 2.0 * s1 * c1);
+    let (c3, s3) = (c2 * c1 - s2 * s1, s2 * c1 + c2 * s1);
+    let (c4, s4) = (c2 * c2 - s2 * s2, 2.0 * s2 * c2);
+    ([c1, c2, c3, c4], [s1, s2, s3, s4])
+}
+
+/// t(x) from the harmonics of x ([`harmonics`]).
+#[inline(always)]
+fn dot_harmonics(t: &Trig, c: &[f64; MAX_HARMONIC], s: &[f64; MAX_HARMONIC]) -> f64 {
+    let mut acc = t.cos[0];
+    for k in 0..MAX_HARMONIC {
+        acc += t.cos[k + 1] * c[k] + t.sin[k + 1] * s[k];
+    }
+    acc
+}
+
+/// A start for the root of F, monotone on [a.x, b.x] and changing sign there: the inverse
+/// Hermite interpolant when both slopes are usable; next to a critical point (an end where F' is
+/// small, near a double root, where Newton from afar would only halve its distance per step),
+/// the root of the second-order Taylor model of F at that end.
+#[inline(always)]
+fn root_start(a: Pt, b: Pt) -> f64 {
+    let h = b.x - a.x;
+    let (e, dir) = if a.d.abs() <= b.d.abs() {
+        (a, 1.0)
+    } else {
+        (b, -1.0)
+    };
+    if e.d.abs() * h < 0.5 * (b.f - a.f).abs() {
+        // F(e.x + dir t) ~ f + dir d t + s t^2 / 2: its smallest positive root.
+        let (q2, q1, q0) = (0.5 * e.s, dir * e.d, e.f);
+        let disc = q1 * q1 - 4.0 * q2 * q0;
+        if disc >= 0.0 {
+            let q = -0.5 * (q1 + q1.signum() * disc.sqrt());
+            let t = [q0 / q, q / q2]
+                .into_iter()
+                .filter(|t| *t > 0.0 && *t < h)
+                .fold(f64::INFINITY, f64::min);
+            if t.is_finite() {
+                return e.x + dir * t;
+            }
+        }
+    }
+    hermite_start(a.x, b.x, a.f, b.f, a.d, b.d)
+}
+
+/// A start for the root of g, monotone on [a, b] with g(a) = ga, g(b) = gb of opposite signs:
+/// the cubic Hermite interpolant of the inverse function x(g) at g = 0 (slopes 1 / g'), or the
+/// secant's root where a slope is unusable.
+#[inline(always)]
+fn hermite_start(a: f64, b: f64, ga: f64, gb: f64, da: f64, db: f64) -> f64 {
+    let dy = gb - ga;
+    let t = -ga / dy;
+    let slope = (b - a) / dy;
+    let usable = |d: f64| d != 0.0 && (d > 0.0) == (slope > 0.0);
+    let x = if usable(da) && usable(db) {
+        let (t2, t3) = (t * t, t * t * t);
+        (2.0 * t3 - 3.0 * t2 + 1.0) * a
+            + (t3 - 2.0 * t2 + t) * dy / da
+            + (3.0 * t2 - 2.0 * t3) * b
+            + (t3 - t2) * dy / db
+    } else {
+        a + t * (b - a)
+    };
+    if x > a && x < b { x } else { 0.5 * (a + b) }
+}
+
+/// Bounds on the derivatives of g over the circle for [`newton_bracketed`]: `m2` on |g''|, and
+/// `m3` on |g'''| when g'' is evaluated too (Chebyshev's steps).
+#[derive(Debug, Clone, Copy)]
+struct StepBounds {
+    m2: f64,
+    m3: Option<f64>,
+}
+
+/// The single root of g, monotone on [a, b] and changing sign there (g(a) = ga), from `start`, by
+/// steps kept inside a shrinking bracket (bisection when a step leaves it). `eval` gives g, g' and
+/// g'' (used only with `bounds.m3`). With d = g / g' the Newton step, the step taken is Newton's,
+/// x - d, which leaves an error of at most m2 d^2 / (2 |g'|); or, with g'', Chebyshev's,
+/// x - d - g'' d^2 / (2 g'), which leaves at most (m2^2 / (2 g'^2) + m3 / (6 |g'|)) |d|^3 (the
+/// e^3 term of its expansion about the root): the iteration stops once that (or the step itself)
+/// is below the rounding of x, or the bracket cannot shrink.
+#[inline(always)]
+fn newton_bracketed(
+    mut a: f64,
+    mut b: f64,
+    ga: f64,
+    start: f64,
+    bounds: StepBounds,
+    eval: impl Fn(f64) -> (f64, f64, f64),
+) -> f64 {
+    let a_neg = ga < 0.0;
+    let mut x = start;
+    for _ in 0..200 {
+        let (g, dg, ddg) = eval(x);
+        if g == 0.0 {
+            return x;
+        }
+        if (g < 0.0) == a_neg {
+            a = x;
+        } else {
+            b = x;
+        }
+        let step = g / dg;
+        let (next, left) = match bounds.m3 {
+            None => (x - step, bounds.m2 * step * step / (2.0 * dg.abs())),
+            Some(m3) => {
+                let inv = 1.0 / dg;
+                let q = bounds.m2 * inv;
+                let step2 = step * step;
+                (
+                    x - step - 0.5 * ddg * inv * step2,
+                    (0.5 * q * q + m3 * inv.abs() * (1.0 / 6.0)) * (step2 * step).abs(),
+                )
+            }
+        };
+        if next > a && next < b {
+            let tol = f64::EPSILON * next.abs().max(1e-3);
+            if step.abs() <= tol || left <= tol {
+                return next;
+            }
+            x = next;
+        } else {
+            x = 0.5 * (a + b);
+        }
+        if b - a <= f64::EPSILON * (a.abs() + b.abs()) {
+            return x;
+        }
+    }
+    x
+}
+
+/// (1+t^2)^4 cos(k x) and (1+t^2)^4 sin(k x) as polynomials in t = tan(x/2): the real and
+/// imaginary parts of (1 + i t)^(4+k) (1 - i t)^(4-k).
+const HALF_ANGLE_COS: [[f64; 9]; 5] = half_angle_table(false);
+const HALF_ANGLE_SIN: [[f64; 9]; 5] = half_angle_table(true);
+
+const fn half_angle_table(imag: bool) -> [[f64; 9]; 5] {
+    let mut table = [[0.0; 9]; 5];
+    let mut k = 0;
+    while k <= 4 {
+        // Complex polynomial coefficients (re, im) of (1 + i t)^(4+k) (1 - i t)^(4-k).
+        let mut re = [0i64; 9];
+        let mut im = [0i64; 9];
+        re[0] = 1;
+        let mut f = 0;
+        while f < 8 {
+            let sign = if f < 4 + k { 1 } else { -1 };
+            // multiply by (1 + sign * i t)
+            let mut nre = [0i64; 9];
+            let mut nim = [0i64; 9];
+            let mut d = 0;
+            while d < 8 {
+                nre[d] += re[d];
+                nim[d] += im[d];
+                // (re + i im) * (sign i t) = -sign im t + i sign re t
+                nre[d + 1] -= sign * im[d];
+                nim[d + 1] += sign * re[d];
+                d += 1;
+            }
+            re = nre;
+            im = nim;
+            f += 1;
+        }
+        let mut d = 0;
+        while d < 9 {
+            table[k][d] = if imag { im[d] as f64 } else { re[d] as f64 };
+            d += 1;
+        }
+        k += 1;
+    }
+    table
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> Trig {
+        Trig {
+            cos: [0.3, -1.2, 0.7, 0.25, -0.4],
+            sin: [0.0, 0.9, -0.3, 0.6, 0.15],
+        }
+    }
+
+    #[test]
+    fn product_matches_pointwise() {
+        let a = Trig::linear(1.5, -0.5, 2.0);
+        let b = Trig {
+            cos: [0.2, 0.4, -1.0, 0.3, 0.0],
+            sin: [0.0, 0.8, 0.5, -0.7, 0.0],
+        };
+        let p = a.mul(&b);
+        for i in 0..50 {
+            let x = -3.0 + i as f64 * 0.13;
+            assert!((p.eval(x) - a.eval(x) * b.eval(x)).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn half_angle_polynomials_match() {
+        let p = sample();
+        for shift in [false, true] {
+            let q = p.to_half_angle_poly(shift);
+            for i in 0..40 {
+                let t = -1.0 + i as f64 * 0.05;
+                let x = 2.0 * t.atan() + if shift { std::f64::consts::PI } else { 0.0 };
+                let lhs = q.iter().rev().fold(0.0, |acc, &a| acc * t + a);
+                let rhs = (1.0 + t * t).powi(4) * p.eval(x);
+                assert!((lhs - rhs).abs() < 1e-12 * (1.0 + rhs.abs()), "{lhs} {rhs}");
+            }
+        }
+    }
+
+    /// prod_i (cos((p_i - q_i)/2) - cos(x - (p_i + q_i)/2)): roots exactly at every p_i, q_i.
+    fn from_pairs(pairs: &[(f64, f64)]) -> Trig {
+        pairs
+            .iter()
+            .fold(Trig::linear(1.0, 0.0, 0.0), |acc, &(p, q)| {
+                let m = 0.5 * (p + q);
+                acc.mul(&Trig::linear((0.5 * (p - q)).cos(), -m.cos(), -m.sin()))
+            })
+    }
+
+    fn circle_dist(a: f64, b: f64) -> f64 {
+        let d = (a - b).rem_euclid(std::f64::consts::TAU);
+        d.min(std::f64::consts::TAU - d)
+    }
+
+    /// Every expected root is within `tol` of a reported one, and every reported one of an
+    /// expected one.
+    fn assert_roots(p: &Trig, want: &[f64], tol: f64) {
+        let got = p.roots();
+        for &w in want {
+            assert!(
+                got.iter().any(|&g| circle_dist(g, w) < tol),
+                "{w} not in {got:?}"
+            );
+        }
+        for &g in &got {
+            assert!(
+                want.iter().any(|&w| circle_dist(g, w) < tol),
+                "{g} not expected: {want:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn roots_on_the_circle() {
+        let pairs = [(-2.9, -2.0), (-1.1, -0.3), (0.4, 1.2), (2.2, 3.0)];
+        let want: Vec<f64> = pairs.iter().flat_map(|&(p, q)| [p, q]).collect();
+        assert_roots(&from_pairs(&pairs), &want, 1e-12);
+        assert_roots(&from_pairs(&pairs).scale(3.7e21), &want, 1e-12);
+        assert!(Trig::linear(2.0, 1.0, 0.5).roots().is_empty());
+        assert!(Trig::default().roots().is_empty());
+    }
+
+    #[test]
+    fn roots_at_grid_points_and_pi() {
+        use std::f64::consts::{FRAC_PI_2, PI};
+        let step = PI / 16.0;
+        let pairs = [
+            (0.0, FRAC_PI_2),
+            (-FRAC_PI_2, 3.0 * step),
+            (PI, -5.0 * step),
+        ];
+        let want: Vec<f64> = pairs.iter().flat_map(|&(p, q)| [p, q]).collect();
+        assert_roots(&from_pairs(&pairs), &want, 1e-12);
+    }
+
+    #[test]
+    fn close_pairs_are_separated() {
+        use std::f64::consts::PI;
+        for (centre, sep) in [
+            (0.1, 6.7e-5),
+            (1.0, 1e-5),
+            (3.0 * PI / 16.0, 1e-5),
+            (-0.0019, 2e-7),
+            (0.0, 1e-7),
+            (PI - 2e-3, 1e-7),
+            (-PI + 1e-4, 1e-7),
+        ] {
+            let pairs = [
+                (centre - 0.5 * sep, centre + 0.5 * sep),
+                (2.0, -2.5),
+                (1.7, 1.9),
+            ];
+            let want: Vec<f64> = pairs.iter().flat_map(|&(p, q)| [p, q]).collect();
+            // 1 - cos(sep / 2) carries the pair's separation in the coefficients: rounded, it
+            // moves the roots by a few percent of sep; a quarter of sep still tells them apart.
+            assert_roots(&from_pairs(&pairs), &want, 0.25 * sep);
+        }
+    }
+
+    #[test]
+    fn double_root_gives_a_candidate() {
+        for x in [0.3, 0.0, std::f64::consts::PI, -1.2] {
+            let p = from_pairs(&[(x, x), (2.0, -2.5)]);
+            assert_roots(&p, &[x, 2.0, -2.5], 1e-7);
+        }
+    }
+
+    /// A form of the highest degree with coefficients from `unit`.
+    fn random_form(unit: &mut impl FnMut() -> f64) -> Trig {
+        let mut p = Trig::default();
+        for k in 0..=MAX_HARMONIC {
+            p.cos[k] = unit();
+            if k > 0 {
+                p.sin[k] = unit();
+            }
+        }
+        p
+    }
+
+    #[test]
+    fn agrees_with_the_half_angle_charts() {
+        let mut uniform = crate::math::test_rng::lcg(0x1234_5678_9abc_def0);
+        let mut unit = || uniform() * 2.0 - 1.0;
+        for _ in 0..3000 {
+            let p = random_form(&mut unit);
+            let mut want = Vec::new();
+            for shift in [false, true] {
+                let q = p.to_half_angle_poly(shift);
+                for r in crate::math::poly::roots_in(&q, -1.0, 1.0) {
+                    want.push(2.0 * r.x.atan() + if shift { std::f64::consts::PI } else { 0.0 });
+                }
+            }
+            assert_roots(&p, &want, 1e-9);
+        }
+    }
+
+    /// [`Trig::roots_sin_cos`] (the AVX2 build where the processor has it) and its baseline
+    /// build give the same roots bit for bit: random forms, forms with double roots and close
+    /// pairs (the chart fallback), zero and not finite.
+    #[test]
+    fn roots_sin_cos_builds_agree() {
+        let mut uniform = crate::math::test_rng::lcg(0x0bad_cafe_1234_5678);
+        let mut unit = || uniform() * 2.0 - 1.0;
+        let mut forms = vec![
+            Trig::default(),
+            Trig::linear(f64::NAN, 1.0, 0.0),
+            Trig::linear(0.0, f64::INFINITY, 1.0),
+        ];
+        for _ in 0..3000 {
+            forms.push(random_form(&mut unit));
+            let (x, sep) = (3.0 * unit(), 1e-9 * (1.0 + unit()));
+            forms.push(from_pairs(&[(x, x + sep), (x - 2.0, 0.5 * unit())]));
+        }
+        let bits = |roots: &[TrigRoot]| -> Vec<[u64; 3]> {
+            roots
+                .iter()
+                .map(|r| [r.x, r.sin, r.cos].map(f64::to_bits))
+                .collect()
+        };
+        for p in &forms {
+            assert_eq!(
+                bits(&p.roots_sin_cos()),
+                bits(&p.roots_sin_cos_baseline()),
+                "{p:?}"
+            );
+        }
+    }
+}

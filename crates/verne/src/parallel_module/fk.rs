@@ -1,0 +1,413 @@
+//! Forward kinematics of the parallel module (IFToMM 2007, section VI): for (rho1, rho2, rho3),
+//! every real assembly mode (xp, yp, zp, alpha).
+//!
+//! Elimination (re-derived; the paper's intermediate systems (S2)-(S3) are not printed). With
+//! u = xp + D1 - d1, z' = zp - rho1, delta = (D2 - d2) - (D1 - d1), p2 = rho2 - rho1,
+//! p3 = rho3 - rho1 and c, s = cos, sin alpha:
+//! - (3) - (4) is eq. (14): w y + R1 s z' = 0, with w = R1 c - r1;
+//! - (6) - (5): 4 y e + 2 z' (2 R2 s + p2 - p3) = b, e = R2 c - r4,
+//!   b = L3^2 - L2^2 + (p2 + p3)(2 R2 s + p2 - p3);
+//!
+//! a linear system in (y, z') whose determinant
+//! Det = 2 (p2 - p3)(R1 c - r1) + 4 (R1 r4 - r1 R2) s is twice the left side of the existence
+//! condition (21). Then
+//! y = -R1 s b / Det, z' = w b / Det, and (5) - (10) gives u = U / (2 delta Det) with
+//! U = A Det + 2 b Q, A = L2^2 - K1 - delta^2 - e^2 - (R2 s + p2)^2, Q = (R1 r4 - r1 R2) s + w p2.
+//! Substituting into (10), u^2 + y^2 + z'^2 = K1 = L1^2 - R1^2 - r1^2 + 2 R1 r1 c, gives
+//!
+//!   F(alpha) = U^2 + 4 delta^2 (b^2 (R1^2 + r1^2 - 2 R1 r1 c) - K1 Det^2) = 0,
+//!
+//! a trigonometric polynomial of degree 4: with t = tan(alpha/2), (1 + t^2)^4 F is the paper's
+//! degree-8 polynomial. Its real roots are isolated directly on the circle by `Trig::roots`
+//! (certified exclusion and monotonicity tests on a grid, the half-angle charts only around a
+//! near-double root). Every root is
+//! back-substituted and polished by Newton on the original equations (3)-(6); where Det ~ 0
+//! (condition (21)) the point is found instead as the intersection of the four spheres at that
+//! alpha, which also yields the two solutions of a degenerate alpha.
+
+use arrayvec::ArrayVec;
+use nalgebra::{Matrix3, Vector3};
+
+pub use crate::certificate::Certificate;
+use crate::certificate::Certified;
+use crate::math::cpu;
+use crate::math::trig::Trig;
+use crate::parallel_module::branches::{Config, Verdict, label};
+use crate::parallel_module::equations::{ModulePose, Sliders, polish_pose_from, residual_mm};
+use crate::parallel_module::fk_certify::{self, ProvedStart};
+use crate::parallel_module::ik::wrap_angle;
+use crate::spec::{Machine, ModuleGeometry};
+use crate::tolerance::{ACCEPT_RESIDUAL_MM, FK_DET_REL, SAME_SOLUTION_MM, SAME_SOLUTION_RAD};
+
+/// Where Det = 0 (condition (21)), the fixed-angle sphere intersection is tried only when
+/// |b| there is below this fraction of its coefficients (a solution needs b = 0).
+const DET_ZERO_B_REL: f64 = 1e-6;
+
+/// How far (rad) the Newton polish may move alpha from a proved root: the root is accurate to
+/// rounding, so a mode farther than this is some other root's.
+const ROOT_POLISH_RAD: f64 = 1e-6;
+
+/// Most assembly modes returned (the degree-8 polynomial, plus degenerate doubled solutions).
+pub const MAX_FK_MODES: usize = 16;
+
+/// One assembly mode.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FkMode {
+    pub pose: ModulePose,
+    pub config: Config,
+    pub verdict: Verdict,
+}
+
+impl FkMode {
+    pub fn working(&self) -> bool {
+        self.verdict.feasible()
+    }
+}
+
+/// Every real assembly mode of one set of slider positions, with the certificate that says why
+/// there are no others. Dereferences to the list of modes.
+pub type FkModes = Certified<FkMode, MAX_FK_MODES>;
+
+/// The linear trigonometric forms of the elimination for one set of slider positions.
+struct Elimination {
+    w: Trig,
+    b: Trig,
+    det: Trig,
+    u_num: Trig,
+    delta: f64,
+}
+
+impl Elimination {
+    #[inline(always)]
+    fn new(g: &ModuleGeometry, rho: &Sliders) -> Elimination {
+        let (r, rr, r2, r4) = (g.r_big1, g.r_small1, g.r_big2, g.r4);
+        let p2 = rho.y - rho.x;
+        let p3 = rho.z - rho.x;
+        let delta = g.dx2 - g.dx1;
+        let k0 = g.l1 * g.l1 - r * r - rr * rr;
+        let w = Trig::linear(-rr, r, 0.0);
+        let b = Trig::linear(
+            g.l3 * g.l3 - g.l2 * g.l2 + (p2 + p3) * (p2 - p3),
+            0.0,
+            2.0 * r2 * (p2 + p3),
+        );
+        let det = Trig::linear(
+            -2.0 * rr * (p2 - p3),
+            2.0 * r * (p2 - p3),
+            4.0 * (r * r4 - rr * r2),
+        );
+        let a = Trig::linear(
+            g.l2 * g.l2 - k0 - delta * delta - r2 * r2 - r4 * r4 - p2 * p2,
+            2.0 * r2 * r4 - 2.0 * r * rr,
+            -2.0 * r2 * p2,
+        );
+        let q = Trig::linear(-rr * p2, r * p2, r * r4 - rr * r2);
+        let u_num = a
+            .mul_deg::<1, 1>(&det)
+            .add(&b.mul_deg::<1, 1>(&q).scale(2.0));
+        Elimination {
+            w,
+            b,
+            det,
+            u_num,
+            delta,
+        }
+    }
+
+    /// F(alpha) of the module documentation (degree 4).
+    #[inline(always)]
+    fn characteristic(&self, g: &ModuleGeometry) -> Trig {
+        let (r, rr) = (g.r_big1, g.r_small1);
+        let n1 = Trig::linear(r * r + rr * rr, -2.0 * r * rr, 0.0);
+        let k1 = Trig::linear(g.l1 * g.l1 - r * r - rr * rr, 2.0 * r * rr, 0.0);
+        let b2 = self.b.mul_deg::<1, 1>(&self.b);
+        let det2 = self.det.mul_deg::<1, 1>(&self.det);
+        let inner = b2
+            .mul_deg::<2, 1>(&n1)
+            .add(&k1.mul_deg::<1, 2>(&det2).scale(-1.0));
+        self.u_num
+            .mul_deg::<2, 2>(&self.u_num)
+            .add(&inner.scale(4.0 * self.delta * self.delta))
+    }
+
+    /// The pose at `alpha` from the linear solution, or None where Det ~ 0; (s, c) = sin, cos of
+    /// alpha.
+    #[inline(always)]
+    fn back_substitute(
+        &self,
+        g: &ModuleGeometry,
+        rho: &Sliders,
+        alpha: f64,
+        (s, c): (f64, f64),
+    ) -> Option<ModulePose> {
+        let det = self.det.eval_sc_deg::<1>(s, c);
+        let det_scale = self.det.cos[0].abs() + self.det.cos[1].abs() + self.det.sin[1].abs();
+        if det.abs() <= FK_DET_REL * det_scale || det_scale == 0.0 {
+            return None;
+        }
+        let b = self.b.eval_sc_deg::<1>(s, c);
+        let y = -g.r_big1 * s * b / det;
+        let zp = self.w.eval_sc_deg::<1>(s, c) * b / det;
+        let u = self.u_num.eval_sc_deg::<2>(s, c) / (2.0 * self.delta * det);
+        Some(ModulePose {
+            p: Vector3::new(u - g.dx1, y, zp + rho.x),
+            alpha,
+        })
+    }
+}
+
+/// The characteristic trigonometric polynomial F(alpha) of the module documentation for the
+/// slider positions (its real roots are the assembly modes' angles).
+pub fn characteristic(g: &ModuleGeometry, rho: &Sliders) -> Trig {
+    Elimination::new(g, rho).characteristic(g)
+}
+
+/// Points P on all four spheres of eqs. (3)-(6) at a fixed alpha: three sphere differences are
+/// planes; a unique point when they meet in one, and up to two points when they share a line
+/// (the degenerate case of condition (21)).
+/// (s, c) = sin, cos of alpha.
+fn fixed_alpha_points(
+    g: &ModuleGeometry,
+    rho: &Sliders,
+    alpha: f64,
+    (s, c): (f64, f64),
+) -> ArrayVec<ModulePose, 2> {
+    let (r, rr, r2, r4) = (g.r_big1, g.r_small1, g.r_big2, g.r4);
+    let centers = [
+        Vector3::new(-g.dx1, rr - r * c, rho.x - r * s),
+        Vector3::new(-g.dx1, r * c - rr, rho.x + r * s),
+        Vector3::new(-g.dx2, r2 * c - r4, rho.y + r2 * s),
+        Vector3::new(-g.dx2, r4 - r2 * c, rho.z - r2 * s),
+    ];
+    let lens = [g.l1, g.l1, g.l2, g.l3];
+    let mut m = Matrix3::zeros();
+    let mut rhs = Vector3::zeros();
+    for j in 1..4 {
+        let d = centers[j] - centers[0];
+        for k in 0..3 {
+            m[(j - 1, k)] = 2.0 * d[k];
+        }
+        rhs[j - 1] = centers[j].norm_squared() - centers[0].norm_squared() - lens[j] * lens[j]
+            + lens[0] * lens[0];
+    }
+    let mut out = ArrayVec::new();
+    let svd = m.svd(true, true);
+    let (Some(u), Some(vt)) = (svd.u, svd.v_t) else {
+        return out;
+    };
+    let sv = svd.singular_values;
+    let smax = sv.max();
+    if smax == 0.0 {
+        return out;
+    }
+    // Least-squares particular solution over the well-determined directions.
+    let mut p0 = Vector3::zeros();
+    let mut null = None;
+    for k in 0..3 {
+        let v = vt.row(k).transpose();
+        if sv[k] > FK_DET_REL * smax {
+            p0 += v * (u.column(k).dot(&rhs) / sv[k]);
+        } else if null.is_none() {
+            null = Some(v);
+        } else {
+            return out; // a plane of candidates: not a finite set, nothing to report
+        }
+    }
+    match null {
+        None => out.push(ModulePose { p: p0, alpha }),
+        Some(n) => {
+            // |p0 + l n - C0|^2 = L1^2, with |n| = 1.
+            let d = p0 - centers[0];
+            let bh = n.dot(&d);
+            let cc = d.norm_squared() - lens[0] * lens[0];
+            let disc = bh * bh - cc;
+            if disc >= 0.0 {
+                let h = disc.sqrt();
+                for l in [-bh - h, -bh + h] {
+                    out.push(ModulePose {
+                        p: p0 + n * l,
+                        alpha,
+                    });
+                }
+            }
+        }
+    }
+    out
+}
+
+/// (sin alpha, cos alpha) where Det = A cos(alpha) + B sin(alpha) + C vanishes (condition
+/// (21)): the line A c + B s + C = 0 met with the unit circle, without trigonometric calls; none,
+/// one or two; none when Det is identically zero or never zero.
+fn det_zeros(det: &Trig) -> ArrayVec<(f64, f64), 2> {
+    let (a, b, c) = (det.cos[1], det.sin[1], det.cos[0]);
+    let r2 = a * a + b * b;
+    let mut out = ArrayVec::new();
+    if r2 == 0.0 || !r2.is_finite() || c * c > r2 {
+        return out;
+    }
+    // The foot of the perpendicular from the origin, -C (A, B) / r^2, plus or minus the half
+    // chord sqrt(r^2 - C^2) along (-B, A) / r.
+    let h = (r2 - c * c).sqrt();
+    let (foot_c, foot_s) = (-c * a / r2, -c * b / r2);
+    let (along_c, along_s) = (-b * h / r2, a * h / r2);
+    out.push((foot_s - along_s, foot_c - along_c));
+    if h != 0.0 {
+        out.push((foot_s + along_s, foot_c + along_c));
+    }
+    out
+}
+
+/// Every real assembly mode for the slider positions, ordered by alpha, each with its
+/// configuration and verdict. Empty when the sliders cannot be assembled. Built with AVX2 where
+/// the processor has it ([`crate::math::cpu`]).
+pub fn solve(m: &Machine, rho: &Sliders) -> FkModes {
+    #[cfg(target_arch = "x86_64")]
+    if cpu::has_avx2() {
+        // SAFETY: the processor has AVX2 (checked just above).
+        return unsafe { solve_avx2(m, rho) };
+    }
+    solve_built::<false>(m, rho)
+}
+
+/// [`solve`] built for the x86-64 baseline whatever the processor has: the same modes, bit for
+/// bit.
+#[doc(hidden)]
+pub fn solve_baseline(m: &Machine, rho: &Sliders) -> FkModes {
+    solve_built::<false>(m, rho)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn solve_avx2(m: &Machine, rho: &Sliders) -> FkModes {
+    solve_built::<true>(m, rho)
+}
+
+/// The body of [`solve`], inlined into each build with what it calls (`AVX2` tells them apart:
+/// see [`crate::math::cpu`]).
+#[inline(always)]
+fn solve_built<const AVX2: bool>(m: &Machine, rho: &Sliders) -> FkModes {
+    let g = &m.module;
+    let mut out = FkModes::new();
+    if !rho.iter().all(|v| v.is_finite()) {
+        return out;
+    }
+    let elim = Elimination::new(g, rho);
+    let f = elim.characteristic(g);
+    let iso = f.isolate_built::<AVX2>(fk_certify::characteristic_error(g, rho), true);
+    // One start pose per proved root (each root of F gives exactly one mode where Det != 0;
+    // next to a zero of Det the factor it belongs to gives it), each with (sin, cos) of alpha.
+    let mut proved: ArrayVec<ProvedStart, 40> = ArrayVec::new();
+    for root in &iso.roots {
+        let (alpha, sc) = (root.x, (root.sin, root.cos));
+        let pose = elim
+            .back_substitute(g, rho, alpha, sc)
+            .or_else(|| fk_certify::pose_at_root_by_factors(g, rho, alpha, sc));
+        match pose {
+            Some(pose) => {
+                let _ = proved.try_push(ProvedStart { pose, sc });
+            }
+            None => out.certificate = Certificate::Unproved,
+        }
+    }
+    // Other starts: what the proof does not predict (any mode they find that the proved roots
+    // did not is a contradiction, and the result is then unproved).
+    let mut others: ArrayVec<ProvedStart, 40> = ArrayVec::new();
+    // Starts of intervals too narrow for double-double that hold at most one mode each: a mode
+    // they find is expected, none is too.
+    let mut allowed: ArrayVec<ProvedStart, 40> = ArrayVec::new();
+    let mut undecided: ArrayVec<[f64; 2], 8> = ArrayVec::new();
+    if !iso.ambiguous.is_empty() {
+        let resolution = fk_certify::resolve(
+            g,
+            rho,
+            &iso.ambiguous,
+            &mut proved,
+            &mut allowed,
+            &mut others,
+            &mut undecided,
+        );
+        out.weaken(Certificate::from(resolution));
+    }
+    // Where condition (21) fails (Det = 0), a real solution forces b = 0 there and F then has
+    // (at least) a double root, F = 4 b^2 (Q^2 + delta^2 (R1^2 + r1^2 - 2 R1 r1 c)) >= 0 (it
+    // happens on a whole plane: L2 = L3, rho2 = rho3, alpha = 0, y_p = 0). Those (at most two)
+    // angles are tried directly on the four spheres, keeping only points that already solve
+    // them: a cross-check of the proof, which finds these modes as roots of the factors.
+    let b_scale = elim.b.cos[0].abs() + elim.b.sin[1].abs();
+    for sc in det_zeros(&elim.det) {
+        // F = 4 b^2 (Q^2 + delta^2 N) > 0 there unless b = 0: no solution at this alpha.
+        if elim.b.eval_sc_deg::<1>(sc.0, sc.1).abs() > DET_ZERO_B_REL * b_scale {
+            continue;
+        }
+        let alpha = wrap_angle(sc.0.atan2(sc.1));
+        // Inside an interval double-double left undecided (narrower than the same-solution
+        // tolerance), the two points are what that interval holds: expected, not a surprise.
+        let near = |x: f64| wrap_angle(x - alpha).abs() <= 1e-12;
+        let expected = undecided.iter().any(|&[a, b]| {
+            near(a) || near(b) || (wrap_angle(alpha - a) >= 0.0 && wrap_angle(b - alpha) >= 0.0)
+        });
+        for pose in fixed_alpha_points(g, rho, alpha, sc) {
+            if residual_mm(g, &pose, rho) <= ACCEPT_RESIDUAL_MM {
+                let to = if expected { &mut allowed } else { &mut others };
+                let _ = to.try_push(ProvedStart { pose, sc });
+            }
+        }
+    }
+    let n_proved = proved.len();
+    let n_expected = n_proved + allowed.len();
+    for (k, start) in proved.iter().chain(&allowed).chain(&others).enumerate() {
+        let (pose, residual, (s, c)) = polish_pose_from(g, start.pose, start.sc, rho);
+        if residual > ACCEPT_RESIDUAL_MM {
+            if k < n_proved {
+                // A proved root whose mode could not be polished: not proved after all.
+                out.certificate = Certificate::Unproved;
+            }
+            continue;
+        }
+        if k < n_proved && wrap_angle(pose.alpha - start.pose.alpha).abs() > ROOT_POLISH_RAD {
+            // The polish left its root's neighbourhood: the mode it found is not that root's.
+            out.certificate = Certificate::Unproved;
+        }
+        let pose = ModulePose {
+            alpha: wrap_angle(pose.alpha),
+            ..pose
+        };
+        let dup = out.iter().any(|o| {
+            wrap_angle(o.pose.alpha - pose.alpha).abs() < SAME_SOLUTION_RAD
+                && (o.pose.p - pose.p).amax() < SAME_SOLUTION_MM * (1.0 + pose.p.amax())
+        });
+        if dup {
+            continue;
+        }
+        if k >= n_expected || out.is_full() {
+            // A mode no proved root predicted (or more than the list holds).
+            out.certificate = Certificate::Unproved;
+            if out.is_full() {
+                continue;
+            }
+        }
+        // wrap_angle moves alpha by whole turns at most: the same sine and cosine.
+        let (config, verdict) = label(m, &pose.p, s, c, rho);
+        out.push(FkMode {
+            pose,
+            config,
+            verdict,
+        });
+    }
+    out.sort_by(|a, b| {
+        a.pose
+            .alpha
+            .total_cmp(&b.pose.alpha)
+            .then(a.config.cmp(&b.config))
+    });
+    out.mark_unproved(|m| &mut m.verdict);
+    out
+}
+
+/// The machine's assembly mode: the feasible one (the smallest |alpha| if several are).
+pub fn working(modes: &[FkMode]) -> Option<&FkMode> {
+    modes
+        .iter()
+        .filter(|b| b.working())
+        .min_by(|a, b| a.pose.alpha.abs().total_cmp(&b.pose.alpha.abs()))
+}

@@ -1,0 +1,408 @@
+//! The forward kinematics' proof of completeness where double precision alone cannot give it:
+//! the intervals of alpha on which [`crate::math::trig::Trig::roots_certified`] could neither exclude
+//! nor isolate a root of F (IFToMM 2007 section VI; see [`crate::parallel_module::fk`]).
+//!
+//! Two methods, tried in this order on each such interval:
+//!
+//! 1. **The two factors of F.** With tau = b / Det (the solution of the linear (y, zp) system is
+//!    (y, zp - rho1) = tau (-R1 sin a, R1 cos a - r1), and xp + D1 - d1 = (A + 2 tau Q) /
+//!    (2 delta)), eq. (10) becomes a quadratic in tau,
+//!
+//!    H1(a, tau) = P tau^2 + R tau + S = 0,  P = 4 (Q^2 + delta^2 N), R = 4 A Q,
+//!    S = A^2 - 4 delta^2 K1,
+//!
+//!    and F = P b^2 + R b Det + S Det^2 = P g+ g-, with g+- = tau+- Det - b and tau+- the two
+//!    roots of H1: (-A Q +- |delta| sqrt(Delta)) / (2 (Q^2 + delta^2 N)),
+//!    Delta = 4 K1 (Q^2 + delta^2 N) - N A^2. Every solution of (3)-(6) at angle a is a root of
+//!    g+ or g- (with its own tau, so its own pose), and there is none where Delta < 0. Where Det
+//!    vanishes (condition (21)), two assembly modes share nearly the same alpha and F has two
+//!    roots closer than its rounding (F is of the order of b^2 there); g+ and g- each have one
+//!    simple root, of the order of b. Each factor is proved monotone on a sub-interval by
+//!    interval arithmetic on its derivative ([`crate::math::interval`]), and its sign change there
+//!    proved at the ends: exactly one root.
+//! 2. **Double-double precision.** (1 + t^2)^4 F as the degree-8 polynomial in t = tan(a/2) (or
+//!    tan((a - pi)/2) away from alpha = 0) of the paper, its coefficients computed in
+//!    double-double from the exact inputs with a running error bound ([`crate::math::dd::Tracked`]);
+//!    exclusion and monotonicity tests as in double precision, with that bound.
+//!
+//! What neither decides is reported: the solution is then marked unproved
+//! ([`crate::parallel_module::fk::Certificate::Unproved`]).
+
+use arrayvec::ArrayVec;
+use nalgebra::Vector3;
+
+pub(crate) use crate::math::certify::Resolution;
+use crate::math::certify::{self, Enclosure, Factor, Lin, Poly8};
+use crate::math::dd::Tracked;
+use crate::math::interval::Iv;
+use crate::math::scalar::{Mag, Scalar};
+use crate::parallel_module::equations::{ModulePose, Sliders};
+use crate::spec::ModuleGeometry;
+
+/// The linear trigonometric forms of the elimination of [`crate::parallel_module::fk`] (its module
+/// documentation), for one set of slider positions, in any arithmetic.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Forms<T> {
+    /// The right side of (6) - (5).
+    pub b: Lin<T>,
+    /// Twice the left side of condition (21).
+    pub det: Lin<T>,
+    pub a: Lin<T>,
+    pub q: Lin<T>,
+    /// R1^2 + r1^2 - 2 R1 r1 cos a.
+    pub n: Lin<T>,
+    /// L1^2 - R1^2 - r1^2 + 2 R1 r1 cos a (eq. (10)).
+    pub k1: Lin<T>,
+    /// (D2 - d2) - (D1 - d1).
+    pub delta: T,
+}
+
+/// The forms of the elimination, each input taken as exact and every operation done in `T`
+/// (the same formulas as [`crate::parallel_module::fk`]'s `Elimination::new`).
+pub(crate) fn forms<T: Scalar>(g: &ModuleGeometry, rho: &Sliders) -> Forms<T> {
+    let t = |x: f64| T::from(x);
+    let (r, rr, r2, r4) = (t(g.r_big1), t(g.r_small1), t(g.r_big2), t(g.r4));
+    let (l1, l2, l3) = (t(g.l1), t(g.l2), t(g.l3));
+    let zero = t(0.0);
+    let p2 = t(rho.y) - t(rho.x);
+    let p3 = t(rho.z) - t(rho.x);
+    let delta = t(g.dx2) - t(g.dx1);
+    let k0 = l1 * l1 - r * r - rr * rr;
+    let two = t(2.0);
+    let four = t(4.0);
+    Forms {
+        b: Lin::new(
+            l3 * l3 - l2 * l2 + (p2 + p3) * (p2 - p3),
+            zero,
+            two * r2 * (p2 + p3),
+        ),
+        det: Lin::new(
+            -(two * rr * (p2 - p3)),
+            two * r * (p2 - p3),
+            four * (r * r4 - rr * r2),
+        ),
+        a: Lin::new(
+            l2 * l2 - k0 - delta * delta - r2 * r2 - r4 * r4 - p2 * p2,
+            two * r2 * r4 - two * r * rr,
+            -(two * r2 * p2),
+        ),
+        q: Lin::new(-(rr * p2), r * p2, r * r4 - rr * r2),
+        n: Lin::new(r * r + rr * rr, -(two * r * rr), zero),
+        k1: Lin::new(k0, two * r * rr, zero),
+        delta,
+    }
+}
+
+/// Rounded operations on any path from an input to a coefficient of F, and on to its value at
+/// a point (a generous count: the coefficient formulas of `Elimination` chain about 60, the
+/// evaluation 15).
+const CHARACTERISTIC_OPS: f64 = 128.0;
+
+/// A bound on |F(alpha) - F_exact(alpha)| for every alpha, F as `fk::characteristic`
+/// computes its coefficients in double precision: `CHARACTERISTIC_OPS` roundings of the
+/// magnitude of F's formula ([`Mag`]), with |lin(alpha)| <= |c0| + |cc| + |cs| for each form
+/// (the bound is a norm that products do not increase).
+pub fn characteristic_error(g: &ModuleGeometry, rho: &Sliders) -> f64 {
+    let m = forms::<Mag>(g, rho);
+    let n1 = |l: &Lin<Mag>| l.c0.0 + l.cc.0 + l.cs.0;
+    let (a, b, det, q) = (n1(&m.a), n1(&m.b), n1(&m.det), n1(&m.q));
+    let u = a * det + 2.0 * b * q;
+    let d2 = m.delta.0 * m.delta.0;
+    let f_mag = u * u + 4.0 * d2 * (b * b * n1(&m.n) + n1(&m.k1) * det * det);
+    CHARACTERISTIC_OPS * f64::EPSILON * f_mag
+}
+
+/// tau+- and what they need, at one angle, in arithmetic `T` ([`Forms`]).
+struct FactorsAt<T> {
+    /// Q^2 + delta^2 N (P / 4).
+    p4: T,
+    /// Delta: H1 has real roots in tau where it is >= 0.
+    disc: T,
+    a: T,
+    q: T,
+    b: T,
+    det: T,
+}
+
+fn factors_at<T: Scalar>(f: &Forms<T>, s: T, c: T) -> FactorsAt<T> {
+    let (a, q, n, k1) = (f.a.at(s, c), f.q.at(s, c), f.n.at(s, c), f.k1.at(s, c));
+    let d2 = f.delta * f.delta;
+    let p4 = q * q + d2 * n;
+    FactorsAt {
+        p4,
+        disc: T::from(4.0) * k1 * p4 - n * a * a,
+        a,
+        q,
+        b: f.b.at(s, c),
+        det: f.det.at(s, c),
+    }
+}
+
+/// The pose of the assembly mode with tau at (sin a, cos a): (y, zp - rho1) = tau (-R1 s, w),
+/// xp + D1 - d1 = (A + 2 tau Q) / (2 delta).
+fn pose_from_tau(
+    g: &ModuleGeometry,
+    rho: &Sliders,
+    alpha: f64,
+    (s, c): (f64, f64),
+    tau: f64,
+    fa: &FactorsAt<f64>,
+    delta: f64,
+) -> ModulePose {
+    let y = -g.r_big1 * s * tau;
+    let zr = (g.r_big1 * c - g.r_small1) * tau;
+    let u = (fa.a + 2.0 * tau * fa.q) / (2.0 * delta);
+    ModulePose {
+        p: Vector3::new(u - g.dx1, y, zr + rho.x),
+        alpha,
+    }
+}
+
+/// The pose at a root of F where Det is too small for the linear solution (condition (21)): the
+/// factor g+- the root belongs to (the smaller |g| there) gives tau and the pose. None where H1
+/// has no real root in tau.
+pub(crate) fn pose_at_root_by_factors(
+    g: &ModuleGeometry,
+    rho: &Sliders,
+    alpha: f64,
+    sc: (f64, f64),
+) -> Option<ModulePose> {
+    let f = forms::<f64>(g, rho);
+    let fa = factors_at(&f, sc.0, sc.1);
+    if !(fa.disc >= 0.0 && fa.p4 > 0.0) {
+        return None;
+    }
+    let root = f.delta.abs() * fa.disc.sqrt();
+    let tau = [(-fa.a * fa.q + root), (-fa.a * fa.q - root)].map(|n| n / (2.0 * fa.p4));
+    let g_of = |t: f64| (t * fa.det - fa.b).abs();
+    let tau = if g_of(tau[0]) <= g_of(tau[1]) {
+        tau[0]
+    } else {
+        tau[1]
+    };
+    Some(pose_from_tau(g, rho, alpha, sc, tau, &fa, f.delta))
+}
+
+/// The start pose of a mode proved at angle `alpha`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ProvedStart {
+    pub pose: ModulePose,
+    pub sc: (f64, f64),
+}
+
+/// One factor g_sigma = tau_sigma Det - b of F, for [`certify::factor_roots`].
+struct FkFactor<'a> {
+    iv: &'a Forms<Iv>,
+    f64: &'a Forms<f64>,
+    sigma: f64,
+}
+
+impl Factor for FkFactor<'_> {
+    /// tau' = -(P' tau^2 + R' tau + S') / (2 P tau + R), with 2 P tau + R = sigma 4 |delta|
+    /// sqrt(Delta) (implicit differentiation of H1 = 0); P = 4 p4, R = 4 A Q,
+    /// S = A^2 - 4 delta^2 K1. Where Delta < 0 there is no solution: Delta's enclosure is cut at
+    /// zero (the derivative's enclosure is then unbounded: only an exclusion can be proved).
+    fn over(&self, lo: f64, hi: f64) -> Enclosure {
+        let f = self.iv;
+        let (s, c) = Iv::new(lo, hi).sin_cos();
+        let fa = factors_at(f, s, c);
+        if fa.disc.negative() {
+            return Enclosure::NoSolution;
+        }
+        if !fa.p4.positive() {
+            return Enclosure::Unknown;
+        }
+        let disc = Iv::new(fa.disc.lo.max(0.0), fa.disc.hi);
+        let root = f.delta.abs() * disc.sqrt() * Iv::point(self.sigma);
+        let tau = (-(fa.a * fa.q) + root) / (Iv::point(2.0) * fa.p4);
+        let (da, dq, dn, dk1) = (
+            f.a.d_at(s, c),
+            f.q.d_at(s, c),
+            f.n.d_at(s, c),
+            f.k1.d_at(s, c),
+        );
+        let d2 = f.delta * f.delta;
+        let four = Iv::point(4.0);
+        let dp = four * (Iv::point(2.0) * fa.q * dq + d2 * dn);
+        let dr = four * (da * fa.q + fa.a * dq);
+        let ds = Iv::point(2.0) * fa.a * da - four * d2 * dk1;
+        let dtau = -(dp * tau.sqr() + dr * tau + ds) / (four * root);
+        Enclosure::Values {
+            g: tau * fa.det - fa.b,
+            dg: dtau * fa.det + tau * f.det.d_at(s, c) - f.b.d_at(s, c),
+        }
+    }
+
+    fn value(&self, x: f64) -> Option<(f64, f64)> {
+        let f = self.f64;
+        let (s, c) = x.sin_cos();
+        let fa = factors_at(f, s, c);
+        if !(fa.disc > 0.0 && fa.p4 > 0.0) {
+            return None;
+        }
+        let root = f.delta.abs() * fa.disc.sqrt() * self.sigma;
+        let tau = (-(fa.a * fa.q) + root) / (2.0 * fa.p4);
+        let (da, dq, dn, dk1) = (
+            f.a.d_at(s, c),
+            f.q.d_at(s, c),
+            f.n.d_at(s, c),
+            f.k1.d_at(s, c),
+        );
+        let d2 = f.delta * f.delta;
+        let dp = 4.0 * (2.0 * fa.q * dq + d2 * dn);
+        let dr = 4.0 * (da * fa.q + fa.a * dq);
+        let ds = 2.0 * fa.a * da - 4.0 * d2 * dk1;
+        let dtau = -(dp * tau * tau + dr * tau + ds) / (4.0 * root);
+        Some((
+            tau * fa.det - fa.b,
+            dtau * fa.det + tau * f.det.d_at(s, c) - f.b.d_at(s, c),
+        ))
+    }
+}
+
+/// Decides each interval of `ambiguous` (alpha, rad; from `Trig::roots_certified`), pushing the
+/// start pose of every mode it proves there into `starts`, and returns the strongest method it
+/// needed. `allowed` receives the starts of intervals narrower than
+/// [`certify::SAME_ROOT_WIDTH`] that double-double could not decide (at most one alpha each,
+/// which the start finds if it is real; those intervals go to `undecided`: at a zero of
+/// condition (21) one alpha carries two modes), `fallback` best-effort starts where nothing
+/// could be proved.
+#[cold]
+#[inline(never)]
+pub(crate) fn resolve(
+    g: &ModuleGeometry,
+    rho: &Sliders,
+    ambiguous: &[[f64; 2]],
+    starts: &mut ArrayVec<ProvedStart, 40>,
+    allowed: &mut ArrayVec<ProvedStart, 40>,
+    fallback: &mut ArrayVec<ProvedStart, 40>,
+    undecided: &mut ArrayVec<[f64; 2], 8>,
+) -> Resolution {
+    let fi = forms::<Iv>(g, rho);
+    let ff = forms::<f64>(g, rho);
+    if !characteristic_error(g, rho).is_finite() {
+        // The elimination overflows: nothing can be proved (and nothing isolated).
+        return Resolution::Unproved;
+    }
+    let factors = [1.0, -1.0].map(|sigma| FkFactor {
+        iv: &fi,
+        f64: &ff,
+        sigma,
+    });
+    let mut worst = Resolution::Factored;
+    for [lo, hi] in certify::pieces(ambiguous) {
+        if let Ok(roots) = certify::all_factor_roots(&factors, lo, hi) {
+            for (k, x) in roots {
+                let sc = x.sin_cos();
+                let fa = factors_at(&ff, sc.0, sc.1);
+                let root = ff.delta.abs() * fa.disc.max(0.0).sqrt() * factors[k].sigma;
+                let tau = (-fa.a * fa.q + root) / (2.0 * fa.p4);
+                let pose = pose_from_tau(g, rho, x, sc, tau, &fa, ff.delta);
+                let _ = starts.try_push(ProvedStart { pose, sc });
+            }
+            continue;
+        }
+        let tf = forms::<Tracked>(g, rho);
+        let found = certify::dd_roots(|at_pi| half_angle_poly(&tf, at_pi), lo, hi);
+        let push = |to: &mut ArrayVec<ProvedStart, 40>, x: f64| {
+            let sc = x.sin_cos();
+            if let Some(pose) = start_at(g, rho, x, sc) {
+                let _ = to.try_push(ProvedStart { pose, sc });
+            }
+        };
+        match found {
+            Ok(found) if found.decided_up_to_same_root() => {
+                worst = worst.max(Resolution::Extended);
+                found.roots.iter().for_each(|&x| push(starts, x));
+                for [a, b] in found.undecided {
+                    push(allowed, 0.5 * (a + b));
+                    let _ = undecided.try_push([a, b]);
+                }
+            }
+            other => {
+                // Best effort where nothing is proved: what was found, and the midpoints.
+                worst = Resolution::Unproved;
+                if let Ok(found) = other {
+                    found.roots.iter().for_each(|&x| push(fallback, x));
+                    found
+                        .undecided
+                        .iter()
+                        .for_each(|[a, b]| push(fallback, 0.5 * (a + b)));
+                }
+                push(fallback, 0.5 * (lo + hi));
+            }
+        }
+    }
+    worst
+}
+
+/// The start pose for a root at alpha: the linear solution of the elimination, or the factor's
+/// where Det is small.
+fn start_at(g: &ModuleGeometry, rho: &Sliders, alpha: f64, sc: (f64, f64)) -> Option<ModulePose> {
+    let f = forms::<f64>(g, rho);
+    let det = f.det.at(sc.0, sc.1);
+    let det_scale = f.det.c0.abs() + f.det.cc.abs() + f.det.cs.abs();
+    if det.abs() > crate::tolerance::FK_DET_REL * det_scale {
+        let fa = factors_at(&f, sc.0, sc.1);
+        let tau = fa.b / det;
+        return Some(pose_from_tau(g, rho, alpha, sc, tau, &fa, f.delta));
+    }
+    pose_at_root_by_factors(g, rho, alpha, sc)
+}
+
+/// (1 + t^2)^4 F as a polynomial in t (chart at 0 or at pi, [`certify::quad`]): with U = A Det
+/// + 2 b Q (degree 4), (1 + t^2)^4 F = U^2 + 4 delta^2 (1 + t^2) (b^2 N - K1 Det^2).
+fn half_angle_poly(f: &Forms<Tracked>, at_pi: bool) -> Poly8 {
+    use certify::{add, mul, quad, scale};
+    let q = |l: &Lin<Tracked>| quad(l, at_pi);
+    let (a, b, det, qq, n, k1) = (q(&f.a), q(&f.b), q(&f.det), q(&f.q), q(&f.n), q(&f.k1));
+    let two = Tracked::exact(2.0);
+    let u = add::<5>(
+        &mul::<3, 3, 5>(&a, &det),
+        &scale(&mul::<3, 3, 5>(&b, &qq), two),
+    );
+    let b2n = mul::<5, 3, 7>(&mul::<3, 3, 5>(&b, &b), &n);
+    let k1d2 = mul::<3, 5, 7>(&k1, &mul::<3, 3, 5>(&det, &det));
+    let one = Tracked::exact(1.0);
+    let inner = mul::<7, 3, 9>(
+        &add::<7>(&b2n, &scale(&k1d2, -one)),
+        &[one, Tracked::exact(0.0), one],
+    );
+    let d2 = f.delta * f.delta * 4.0;
+    add::<9>(&mul::<5, 5, 9>(&u, &u), &scale(&inner, d2))
+}
+
+/// For tests: the proved roots of the two factors over [lo, hi], as angles.
+#[doc(hidden)]
+pub fn factor_root_angles(g: &ModuleGeometry, rho: &Sliders, lo: f64, hi: f64) -> Option<Vec<f64>> {
+    let fi = forms::<Iv>(g, rho);
+    let ff = forms::<f64>(g, rho);
+    let factors = [1.0, -1.0].map(|sigma| FkFactor {
+        iv: &fi,
+        f64: &ff,
+        sigma,
+    });
+    let roots = certify::all_factor_roots(&factors, lo, hi).ok()?;
+    Some(roots.iter().map(|r| r.1).collect())
+}
+
+/// For tests: what double-double proves over [lo, hi]: roots and undecided intervals, as angles.
+#[doc(hidden)]
+pub fn dd_root_angles_full(
+    g: &ModuleGeometry,
+    rho: &Sliders,
+    lo: f64,
+    hi: f64,
+) -> Option<(Vec<f64>, Vec<[f64; 2]>)> {
+    let tf = forms::<Tracked>(g, rho);
+    let out = certify::dd_roots(|at_pi| half_angle_poly(&tf, at_pi), lo, hi).ok()?;
+    Some((out.roots.to_vec(), out.undecided.to_vec()))
+}
+
+/// For tests: the proved roots of F over [lo, hi] in double-double, as angles.
+#[doc(hidden)]
+pub fn dd_root_angles(g: &ModuleGeometry, rho: &Sliders, lo: f64, hi: f64) -> Option<Vec<f64>> {
+    let tf = forms::<Tracked>(g, rho);
+    let out = certify::dd_roots(|at_pi| half_angle_poly(&tf, at_pi), lo, hi).ok()?;
+    out.undecided.is_empty().then(|| out.roots.to_vec())
+}

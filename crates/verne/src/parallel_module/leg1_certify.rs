@@ -1,0 +1,297 @@
+//! Leg I's two postures as the two factors of the inverse kinematics' eliminated equation: the
+//! proof of completeness where double precision alone cannot give it ([`crate::math::certify`]), for
+//! the machine's theta1 equation (15) along a tool pose (AIM 2007;
+//! [`crate::machine::theta1_equation`]) and for the module's equation in alpha at a fixed
+//! point (IFToMM 2007 eq. (7), whose cubic in cos(alpha) is eq. (9)).
+//!
+//! Along a tool pose, P(theta1) = (w_x, c w_y - s w_z, d_a + s w_y + c w_z) and alpha = theta1 +
+//! phi1 (AIM 2007 eqs. (7)-(9), (14)); at a fixed point, P is constant and the angle is alpha.
+//! With N = R1^2 + r1^2 - 2 R1 r1 cos a = (R1 cos a - r1)^2 + R1^2 sin^2 a, the equation
+//! factors:
+//!
+//!   F = R1^2 sin^2 a (u^2 - K1) + yp^2 N = h+ h-,
+//!   h_sigma = yp (R1 cos a - r1) + sigma R1 sin a sqrt(K1 - u^2 - yp^2),
+//!
+//! and a root of h_sigma is the leg-I posture with rho1 - zp = -sigma sqrt(K1 - u^2 - yp^2)
+//! (eqs. (10) and (14) of IFToMM 2007). Where sin(alpha) = 0 and yp = 0 (Table II: both signs
+//! of rho1 - zp) F has a double root; each factor has a simple one. Close pairs of roots of the
+//! cubic (9) (two postures about to merge) are two simple roots of the factors too, or none.
+
+use arrayvec::ArrayVec;
+use nalgebra::Vector3;
+
+use crate::math::certify::{self, Enclosure, Factor, Lin, Poly8, Resolution};
+use crate::math::dd::Tracked;
+use crate::math::interval::Iv;
+use crate::math::scalar::{Mag, Scalar};
+use crate::spec::{Machine, ModuleGeometry};
+
+/// The linear forms in theta1 of the equation along one tool pose, in any arithmetic.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct PathForms<T> {
+    yp: Lin<T>,
+    zp: Lin<T>,
+    sa: Lin<T>,
+    /// R1 cos(alpha) - r1.
+    wf: Lin<T>,
+    /// L1^2 - R1^2 - r1^2 + 2 R1 r1 cos(alpha).
+    k1: Lin<T>,
+    /// u^2 = (xp + D1 - d1)^2 (constant along the pose).
+    u2: T,
+    r: T,
+}
+
+/// The forms from the tilt-frame platform point `w` and (sin, cos) of phi1, taken as exact.
+pub(crate) fn path_forms<T: Scalar>(
+    m: &Machine,
+    w: &Vector3<f64>,
+    sp: f64,
+    cp: f64,
+) -> PathForms<T> {
+    let t = |x: f64| T::from(x);
+    let g = &m.module;
+    let (r, rr) = (t(g.r_big1), t(g.r_small1));
+    let zero = t(0.0);
+    let (sp, cp) = (t(sp), t(cp));
+    let u = t(w.x) + t(g.dx1);
+    let rr2 = t(2.0) * r * rr;
+    PathForms {
+        yp: Lin::new(zero, t(w.y), -t(w.z)),
+        zp: Lin::new(t(m.table.d_a), t(w.z), t(w.y)),
+        sa: Lin::new(zero, sp, cp),
+        wf: Lin::new(-rr, r * cp, -(r * sp)),
+        k1: Lin::new(t(g.l1) * t(g.l1) - r * r - rr * rr, rr2 * cp, -(rr2 * sp)),
+        u2: u * u,
+        r,
+    }
+}
+
+/// The forms at a fixed point P (the module's inverse kinematics): the angle is alpha itself.
+pub(crate) fn point_forms<T: Scalar>(g: &ModuleGeometry, p: &Vector3<f64>) -> PathForms<T> {
+    let t = |x: f64| T::from(x);
+    let (r, rr) = (t(g.r_big1), t(g.r_small1));
+    let (zero, one) = (t(0.0), t(1.0));
+    let u = t(p.x) + t(g.dx1);
+    let rr2 = t(2.0) * r * rr;
+    PathForms {
+        yp: Lin::new(t(p.y), zero, zero),
+        zp: Lin::new(t(p.z), zero, zero),
+        sa: Lin::new(zero, zero, one),
+        wf: Lin::new(-rr, r, zero),
+        k1: Lin::new(t(g.l1) * t(g.l1) - r * r - rr * rr, rr2, zero),
+        u2: u * u,
+        r,
+    }
+}
+
+/// Every leg-I posture (alpha, rho1) of the point `p` with alpha in [lo, hi] (rad), proved by
+/// the two factors; Err where that cannot be proved.
+pub(crate) fn postures_in(
+    g: &ModuleGeometry,
+    p: &Vector3<f64>,
+    lo: f64,
+    hi: f64,
+) -> Result<ArrayVec<Proved, 16>, ()> {
+    let fi = point_forms::<Iv>(g, p);
+    let ff = point_forms::<f64>(g, p);
+    let factors = [1.0, -1.0].map(|sigma| Posture {
+        iv: &fi,
+        f64: &ff,
+        sigma,
+    });
+    let roots = certify::all_factor_roots(&factors, lo, hi)?;
+    Ok(roots
+        .iter()
+        .map(|&(k, x)| (x, factor_rho1(&ff, x, factors[k].sigma)))
+        .collect())
+}
+
+/// rho1 of the posture of factor sigma at the angle x: zp - sigma sqrt(rad).
+fn factor_rho1(f: &PathForms<f64>, x: f64, sigma: f64) -> f64 {
+    let (s, c) = x.sin_cos();
+    let yp = f.yp.at(s, c);
+    let rad = (f.k1.at(s, c) - f.u2 - yp * yp).max(0.0);
+    f.zp.at(s, c) - sigma * rad.sqrt()
+}
+
+/// Rounded operations on any path from an input to a coefficient of eq. (15) and through its
+/// evaluation (about 25): a generous count.
+const EQUATION_OPS: f64 = 64.0;
+
+/// A bound on |F(theta1) - F_exact(theta1)| for every theta1, F as `theta1_equation` computes its
+/// coefficients: the magnitude of its formula ([`Mag`]) times the rounding of
+/// [`EQUATION_OPS`] operations.
+pub(crate) fn equation_error(m: &Machine, w: &Vector3<f64>, sp: f64, cp: f64) -> f64 {
+    let f = path_forms::<Mag>(m, w, sp, cp);
+    let n1 = |l: &Lin<Mag>| l.c0.0 + l.cc.0 + l.cs.0;
+    let (r, rr) = (m.module.r_big1, m.module.r_small1);
+    // |cos a| and |sin a| share the bound |sp| + |cp|.
+    let trig = n1(&f.sa);
+    let u2_k1 = f.u2.0 + n1(&f.k1);
+    let n = r * r + rr * rr + 2.0 * r * rr * trig;
+    let mag = r * r * n1(&f.sa) * n1(&f.sa) * u2_k1 + n1(&f.yp) * n1(&f.yp) * n;
+    EQUATION_OPS * f64::EPSILON * mag
+}
+
+/// One factor h_sigma of the module documentation.
+struct Posture<'a> {
+    iv: &'a PathForms<Iv>,
+    f64: &'a PathForms<f64>,
+    sigma: f64,
+}
+
+impl Factor for Posture<'_> {
+    /// h' = yp' wf + yp wf' + sigma R1 (sa' q + sa rad' / (2 q)), q = sqrt(rad), rad = K1 - u^2
+    /// - yp^2. Where rad < 0 leg I cannot reach: no solution; rad's enclosure is cut at zero.
+    fn over(&self, lo: f64, hi: f64) -> Enclosure {
+        let f = self.iv;
+        let (s, c) = Iv::new(lo, hi).sin_cos();
+        let yp = f.yp.at(s, c);
+        let rad = f.k1.at(s, c) - f.u2 - yp.sqr();
+        if rad.negative() {
+            return Enclosure::NoSolution;
+        }
+        let q = Iv::new(rad.lo.max(0.0), rad.hi).sqrt();
+        let (sa, wf) = (f.sa.at(s, c), f.wf.at(s, c));
+        let sig = Iv::point(self.sigma);
+        let dyp = f.yp.d_at(s, c);
+        let drad = f.k1.d_at(s, c) - Iv::point(2.0) * yp * dyp;
+        Enclosure::Values {
+            g: yp * wf + sig * f.r * sa * q,
+            dg: dyp * wf
+                + yp * f.wf.d_at(s, c)
+                + sig * f.r * (f.sa.d_at(s, c) * q + sa * drad / (Iv::point(2.0) * q)),
+        }
+    }
+
+    fn value(&self, x: f64) -> Option<(f64, f64)> {
+        let f = self.f64;
+        let (s, c) = x.sin_cos();
+        let yp = f.yp.at(s, c);
+        let rad = f.k1.at(s, c) - f.u2 - yp * yp;
+        if rad <= 0.0 {
+            return None;
+        }
+        let q = rad.sqrt();
+        let (sa, wf) = (f.sa.at(s, c), f.wf.at(s, c));
+        let dyp = f.yp.d_at(s, c);
+        let drad = f.k1.d_at(s, c) - 2.0 * yp * dyp;
+        Some((
+            yp * wf + self.sigma * f.r * sa * q,
+            dyp * wf
+                + yp * f.wf.d_at(s, c)
+                + self.sigma * f.r * (f.sa.d_at(s, c) * q + sa * drad / (2.0 * q)),
+        ))
+    }
+}
+
+/// rho1 of the leg-I posture at a root theta1 = x of F: zp - sigma sqrt(rad) for the factor
+/// h_sigma the root belongs to (the smaller |h| there); None where leg I cannot reach.
+pub(crate) fn posture_rho1(f: &PathForms<f64>, x: f64) -> Option<f64> {
+    let (s, c) = x.sin_cos();
+    let yp = f.yp.at(s, c);
+    let rad = f.k1.at(s, c) - f.u2 - yp * yp;
+    if rad < 0.0 {
+        return None;
+    }
+    let q = rad.sqrt();
+    let h = |sigma: f64| (yp * f.wf.at(s, c) + sigma * f.r * f.sa.at(s, c) * q).abs();
+    let sigma = if h(1.0) <= h(-1.0) { 1.0 } else { -1.0 };
+    Some(f.zp.at(s, c) - sigma * q)
+}
+
+/// The postures of both signs of rho1 - zp at the angle x (where leg I reaches).
+fn both_signs(f: &PathForms<f64>, x: f64, to: &mut ArrayVec<Proved, 12>) {
+    for sigma in [1.0, -1.0] {
+        let (s, c) = x.sin_cos();
+        let yp = f.yp.at(s, c);
+        if f.k1.at(s, c) - f.u2 - yp * yp >= 0.0 {
+            let _ = to.try_push((x, factor_rho1(f, x, sigma)));
+        }
+    }
+}
+
+/// A proved root of F: theta1 with its posture's rho1.
+pub(crate) type Proved = (f64, f64);
+
+/// Decides each interval of `ambiguous` (theta1, rad), pushing every proved posture into
+/// `proved`, and returns the strongest method needed; `allowed` receives the postures of
+/// intervals narrower than [`certify::SAME_ROOT_WIDTH`] that double-double could not decide,
+/// `fallback` best-effort postures where nothing could be proved.
+#[cold]
+#[inline(never)]
+pub(crate) fn resolve(
+    m: &Machine,
+    w: &Vector3<f64>,
+    (sp, cp): (f64, f64),
+    ambiguous: &[[f64; 2]],
+    proved: &mut ArrayVec<Proved, 12>,
+    allowed: &mut ArrayVec<Proved, 12>,
+    fallback: &mut ArrayVec<Proved, 12>,
+) -> Resolution {
+    let fi = path_forms::<Iv>(m, w, sp, cp);
+    let ff = path_forms::<f64>(m, w, sp, cp);
+    if !equation_error(m, w, sp, cp).is_finite() {
+        return Resolution::Unproved;
+    }
+    let factors = [1.0, -1.0].map(|sigma| Posture {
+        iv: &fi,
+        f64: &ff,
+        sigma,
+    });
+    let mut worst = Resolution::Factored;
+    for [lo, hi] in certify::pieces(ambiguous) {
+        if let Ok(roots) = certify::all_factor_roots(&factors, lo, hi) {
+            for (k, x) in roots {
+                let _ = proved.try_push((x, factor_rho1(&ff, x, factors[k].sigma)));
+            }
+            continue;
+        }
+        let tf = path_forms::<Tracked>(m, w, sp, cp);
+        let found = certify::dd_roots(|at_pi| half_angle_poly(&tf, at_pi), lo, hi);
+        let push = |to: &mut ArrayVec<Proved, 12>, x: f64| {
+            if let Some(rho1) = posture_rho1(&ff, x) {
+                let _ = to.try_push((x, rho1));
+            }
+        };
+        match found {
+            Ok(found) if found.decided_up_to_same_root() => {
+                worst = worst.max(Resolution::Extended);
+                found.roots.iter().for_each(|&x| push(proved, x));
+                // At most one posture per sign of rho1 - zp in each: both tried.
+                for [a, b] in found.undecided {
+                    both_signs(&ff, 0.5 * (a + b), allowed);
+                }
+            }
+            other => {
+                worst = Resolution::Unproved;
+                if let Ok(found) = other {
+                    found.roots.iter().for_each(|&x| push(fallback, x));
+                    for [a, b] in found.undecided {
+                        both_signs(&ff, 0.5 * (a + b), fallback);
+                    }
+                }
+                both_signs(&ff, 0.5 * (lo + hi), fallback);
+            }
+        }
+    }
+    worst
+}
+
+/// (1 + t^2)^4 F as a polynomial in t ([`certify::quad`]), F = R1^2 sa^2 (u^2 - K1) + yp^2 N
+/// with N = wf^2 + R1^2 sa^2: the paper's degree-6 polynomial times 1 + t^2 (no real root).
+fn half_angle_poly(f: &PathForms<Tracked>, at_pi: bool) -> Poly8 {
+    use certify::{add, mul, quad, scale};
+    let q = |l: &Lin<Tracked>| quad(l, at_pi);
+    let (sa, yp, k1, wf) = (q(&f.sa), q(&f.yp), q(&f.k1), q(&f.wf));
+    let one = Tracked::exact(1.0);
+    let zero = Tracked::exact(0.0);
+    // (1 + t^2) (u^2 - K1).
+    let u2_k1 = [f.u2 - k1[0], -k1[1], f.u2 - k1[2]];
+    let r2 = f.r * f.r;
+    let sa2 = mul::<3, 3, 5>(&sa, &sa);
+    let n = add::<5>(&mul::<3, 3, 5>(&wf, &wf), &scale(&sa2, r2));
+    let first = mul::<7, 3, 9>(&scale(&mul::<5, 3, 7>(&sa2, &u2_k1), r2), &[one, zero, one]);
+    let second = mul::<5, 5, 9>(&mul::<3, 3, 5>(&yp, &yp), &n);
+    add::<9>(&first, &second)
+}

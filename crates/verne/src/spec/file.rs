@@ -1,0 +1,705 @@
+//! The VERNE machine file (TOML or two-column CSV): its schema, reading and validation.
+//!
+//! Both formats map to the same dotted keys (`module.R1`, `limits.rho1_max`, ...). Reading never
+//! stops at the first problem: every missing, unknown, mistyped or out-of-range key is reported,
+//! each with the line it is on.
+
+use super::{Limits, Machine, ModuleGeometry, TableGeometry};
+use crate::error::{MachineError, Problem};
+
+/// Largest length of the module a machine file may give (mm): the forward kinematics' degree-8
+/// polynomial has coefficients of the eighth power of the lengths, and 1e30^8 is near the largest
+/// double; a kilometre is 1e6 mm.
+pub const MAX_LENGTH_MM: f64 = 1e30;
+
+/// How a key's value is read and checked.
+#[derive(Clone, Copy)]
+enum Check {
+    /// A length that must be > 0 (mm).
+    Positive,
+    /// Any finite number (mm).
+    Finite,
+    /// An angle in degrees within (0, 90].
+    TiltDegrees,
+    /// An angle in degrees within [-180, 180].
+    AngleDegrees,
+}
+
+/// The schema of a VERNE machine file: (section, key, check, meaning).
+const SCHEMA: &[(&str, &str, Check, &str)] = &[
+    (
+        "module",
+        "D1",
+        Check::Finite,
+        "x offset of leg I, base side (mm)",
+    ),
+    (
+        "module",
+        "d1",
+        Check::Finite,
+        "x offset of leg I, platform side (mm)",
+    ),
+    (
+        "module",
+        "R1",
+        Check::Positive,
+        "leg-I platform half-width (mm)",
+    ),
+    (
+        "module",
+        "r1",
+        Check::Positive,
+        "leg-I slider half-width (mm)",
+    ),
+    ("module", "L1", Check::Positive, "leg-I rod length (mm)"),
+    (
+        "module",
+        "D2",
+        Check::Finite,
+        "x offset of legs II-III, base side (mm)",
+    ),
+    (
+        "module",
+        "d2",
+        Check::Finite,
+        "x offset of legs II-III, platform side (mm)",
+    ),
+    (
+        "module",
+        "R2",
+        Check::Positive,
+        "legs II-III platform half-width (mm)",
+    ),
+    (
+        "module",
+        "r4",
+        Check::Positive,
+        "half-distance between sliders II and III (mm)",
+    ),
+    ("module", "L2", Check::Positive, "leg-II rod length (mm)"),
+    ("module", "L3", Check::Positive, "leg-III rod length (mm)"),
+    (
+        "limits",
+        "rho1_min",
+        Check::Finite,
+        "slider 1 lower stroke limit (mm)",
+    ),
+    (
+        "limits",
+        "rho1_max",
+        Check::Finite,
+        "slider 1 upper stroke limit (mm)",
+    ),
+    (
+        "limits",
+        "rho2_min",
+        Check::Finite,
+        "slider 2 lower stroke limit (mm)",
+    ),
+    (
+        "limits",
+        "rho2_max",
+        Check::Finite,
+        "slider 2 upper stroke limit (mm)",
+    ),
+    (
+        "limits",
+        "rho3_min",
+        Check::Finite,
+        "slider 3 lower stroke limit (mm)",
+    ),
+    (
+        "limits",
+        "rho3_max",
+        Check::Finite,
+        "slider 3 upper stroke limit (mm)",
+    ),
+    (
+        "limits",
+        "rod_tilt_max",
+        Check::TiltDegrees,
+        "largest rod tilt (degrees, 0 < v <= 90)",
+    ),
+    (
+        "limits",
+        "theta1_min",
+        Check::AngleDegrees,
+        "tilting axis lower limit (degrees)",
+    ),
+    (
+        "limits",
+        "theta1_max",
+        Check::AngleDegrees,
+        "tilting axis upper limit (degrees)",
+    ),
+    (
+        "table",
+        "d_a",
+        Check::Finite,
+        "table: base to tilting axis along z (mm)",
+    ),
+    (
+        "table",
+        "d_t",
+        Check::Finite,
+        "table: tilting axis to table top along z (mm)",
+    ),
+    ("tool", "length", Check::Finite, "tool length Delta (mm)"),
+];
+
+const TOP_LEVEL_KEYS: &[&str] = &["kind", "name"];
+
+impl Machine {
+    /// Parses a machine file, choosing the format from its content: a first non-comment line
+    /// `key,value` means CSV, anything else TOML.
+    pub fn from_str_auto(text: &str, source: &str) -> Result<Machine, MachineError> {
+        let first = text
+            .trim_start_matches('\u{feff}')
+            .lines()
+            .map(str::trim)
+            .find(|l| !l.is_empty() && !l.starts_with('#'));
+        match first {
+            Some(l) if l.replace(' ', "").eq_ignore_ascii_case("key,value") => {
+                Machine::from_csv_str(text, source)
+            }
+            _ => Machine::from_toml_str(text, source),
+        }
+    }
+
+    /// Parses and validates a TOML machine file.
+    pub fn from_toml_str(text: &str, source: &str) -> Result<Machine, MachineError> {
+        let text = text.trim_start_matches('\u{feff}');
+        let table: toml::Table = match text.parse() {
+            Ok(t) => t,
+            Err(e) => {
+                let line = e
+                    .span()
+                    .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
+                return Err(MachineError {
+                    source: source.to_string(),
+                    problems: vec![Problem {
+                        line,
+                        key: String::new(),
+                        message: format!(
+                            "not valid TOML: {}",
+                            e.message().trim().replace('\n', "; ")
+                        ),
+                    }],
+                });
+            }
+        };
+        let mut entries = Vec::new();
+        let mut problems = Vec::new();
+        for (k, v) in &table {
+            match v {
+                toml::Value::Table(section) => {
+                    for (kk, vv) in section {
+                        let key = format!("{k}.{kk}");
+                        let line = find_toml_line(text, k, kk);
+                        entries.push(Entry {
+                            key,
+                            value: toml_value(vv),
+                            line,
+                        });
+                    }
+                }
+                other => entries.push(Entry {
+                    key: k.clone(),
+                    value: toml_value(other),
+                    line: find_toml_line(text, "", k),
+                }),
+            }
+        }
+        problems.extend(check_sections(&table, text));
+        finish(entries, problems, source)
+    }
+
+    /// Parses and validates a two-column CSV machine file (`key,value` header, dotted keys).
+    pub fn from_csv_str(text: &str, source: &str) -> Result<Machine, MachineError> {
+        let mut entries = Vec::new();
+        let mut problems = Vec::new();
+        let mut seen_header = false;
+        for (i, raw) in text.trim_start_matches('\u{feff}').lines().enumerate() {
+            let line_no = i + 1;
+            let line = raw.trim();
+            if line.is_empty() || line.starts_with('#') {
+                continue;
+            }
+            if !seen_header {
+                seen_header = true;
+                continue;
+            }
+            let Some((k, v)) = line.split_once(',') else {
+                problems.push(Problem {
+                    line: Some(line_no),
+                    key: String::new(),
+                    message: format!("expected `key,value`, found `{line}`"),
+                });
+                continue;
+            };
+            let v = v.trim().trim_matches('"');
+            let value = match v.parse::<f64>() {
+                Ok(x) => Value::Number(x),
+                Err(_) => Value::Text(v.to_string()),
+            };
+            entries.push(Entry {
+                key: k.trim().trim_matches('"').to_string(),
+                value,
+                line: Some(line_no),
+            });
+        }
+        finish(entries, problems, source)
+    }
+
+    /// Validates the machine as a whole (what the schema of single keys cannot see).
+    fn cross_checks(&self, lines: &dyn Fn(&str) -> Option<usize>) -> Vec<Problem> {
+        let mut out = Vec::new();
+        let m = &self.module;
+        let mut push = |key: &str, message: String| {
+            out.push(Problem {
+                line: lines(key),
+                key: key.to_string(),
+                message,
+            })
+        };
+        let lengths = [
+            ("module.D1", m.dx1),
+            ("module.D2", m.dx2),
+            ("module.R1", m.r_big1),
+            ("module.r1", m.r_small1),
+            ("module.L1", m.l1),
+            ("module.R2", m.r_big2),
+            ("module.r4", m.r4),
+            ("module.L2", m.l2),
+            ("module.L3", m.l3),
+        ];
+        for (key, v) in lengths {
+            if v.abs() > MAX_LENGTH_MM {
+                push(
+                    key,
+                    format!(
+                        "{v:e} mm is beyond {MAX_LENGTH_MM:e} mm: the forward kinematics' degree-8 polynomial in it would overflow"
+                    ),
+                );
+            }
+        }
+        if (m.dx1 - m.dx2).abs() < 1e-6 {
+            push(
+                "module.D2",
+                "D2 - d2 must differ from D1 - d1: the forward kinematics eliminates xp between legs I and II".into(),
+            );
+        }
+        if (m.r_big1 - m.r_small1).abs() < 1e-6 {
+            push(
+                "module.r1",
+                "r1 must differ from R1 (leg I would be a parallelogram and the platform could not rotate)".into(),
+            );
+        }
+        if m.l1 <= (m.r_big1 - m.r_small1).abs() {
+            push(
+                "module.L1",
+                format!(
+                    "L1 = {} mm is too short to reach: it must exceed |R1 - r1| = {} mm",
+                    m.l1,
+                    (m.r_big1 - m.r_small1).abs()
+                ),
+            );
+        }
+        let gap = m.r4 - m.r_big2;
+        for (key, l) in [("module.L2", m.l2), ("module.L3", m.l3)] {
+            if l <= gap {
+                push(
+                    key,
+                    format!(
+                        "{} = {l} mm is too short to reach: the slider and platform joints are at least r4 - R2 = {gap} mm apart, so the machine has no workspace",
+                        &key[7..]
+                    ),
+                );
+            }
+        }
+        if m.r_big1 <= m.r_small1 {
+            push(
+                "module.R1",
+                format!(
+                    "R1 = {} mm <= r1 = {} mm: R1 cos(alpha) > r1 never holds, the leg-I rods always cross",
+                    m.r_big1, m.r_small1
+                ),
+            );
+        }
+        for j in 0..3 {
+            if self.limits.rho_min[j] >= self.limits.rho_max[j] {
+                push(
+                    &format!("limits.rho{}_max", j + 1),
+                    format!(
+                        "rho{}_max = {} must be greater than rho{}_min = {}",
+                        j + 1,
+                        self.limits.rho_max[j],
+                        j + 1,
+                        self.limits.rho_min[j]
+                    ),
+                );
+            }
+        }
+        if self.limits.theta1_min >= self.limits.theta1_max {
+            push(
+                "limits.theta1_max",
+                "theta1_max must be greater than theta1_min".into(),
+            );
+        }
+        out
+    }
+
+    /// The machine as a TOML file (degrees), suitable for `-m`.
+    pub fn to_toml(&self) -> String {
+        let m = &self.module;
+        let l = &self.limits;
+        format!(
+            "kind = \"verne\"\nname = {:?}\n\n[module]\nD1 = {}\nd1 = 0.0\nR1 = {}\nr1 = {}\nL1 = {}\nD2 = {}\nd2 = 0.0\nR2 = {}\nr4 = {}\nL2 = {}\nL3 = {}\n\n[limits]\nrho1_min = {}\nrho1_max = {}\nrho2_min = {}\nrho2_max = {}\nrho3_min = {}\nrho3_max = {}\nrod_tilt_max = {}\ntheta1_min = {}\ntheta1_max = {}\n\n[table]\nd_a = {}\nd_t = {}\n\n[tool]\nlength = {}\n",
+            self.name,
+            m.dx1,
+            m.r_big1,
+            m.r_small1,
+            m.l1,
+            m.dx2,
+            m.r_big2,
+            m.r4,
+            m.l2,
+            m.l3,
+            l.rho_min[0],
+            l.rho_max[0],
+            l.rho_min[1],
+            l.rho_max[1],
+            l.rho_min[2],
+            l.rho_max[2],
+            l.rod_tilt_max.to_degrees(),
+            l.theta1_min.to_degrees(),
+            l.theta1_max.to_degrees(),
+            self.table.d_a,
+            self.table.d_t,
+            self.tool_length
+        )
+    }
+}
+
+#[derive(Debug, Clone)]
+enum Value {
+    Number(f64),
+    Text(String),
+    Other(&'static str),
+}
+
+struct Entry {
+    key: String,
+    value: Value,
+    line: Option<usize>,
+}
+
+fn toml_value(v: &toml::Value) -> Value {
+    match v {
+        toml::Value::Float(x) => Value::Number(*x),
+        toml::Value::Integer(i) => Value::Number(*i as f64),
+        toml::Value::String(s) => Value::Text(s.clone()),
+        toml::Value::Boolean(_) => Value::Other("a boolean"),
+        toml::Value::Datetime(_) => Value::Other("a date"),
+        toml::Value::Array(_) => Value::Other("an array"),
+        toml::Value::Table(_) => Value::Other("a table"),
+    }
+}
+
+/// Sections that are not tables, or unknown sections, are reported once.
+fn check_sections(table: &toml::Table, text: &str) -> Vec<Problem> {
+    let mut out = Vec::new();
+    for section in ["module", "limits", "table", "tool", "verify"] {
+        if let Some(v) = table.get(section)
+            && !v.is_table()
+        {
+            out.push(Problem {
+                line: find_toml_line(text, "", section),
+                key: section.to_string(),
+                message: format!("expected a [{section}] table"),
+            });
+        }
+    }
+    out
+}
+
+/// The 1-based line of `key` inside `[section]` (or at top level when `section` is empty).
+fn find_toml_line(text: &str, section: &str, key: &str) -> Option<usize> {
+    let mut current = String::new();
+    for (i, line) in text.lines().enumerate() {
+        let t = line.trim();
+        if let Some(rest) = t.strip_prefix('[') {
+            current = rest.trim_end_matches(']').trim().to_string();
+            continue;
+        }
+        if current == section {
+            let lhs = t.split('=').next().unwrap_or("").trim().trim_matches('"');
+            if lhs == key && t.contains('=') {
+                return Some(i + 1);
+            }
+        }
+    }
+    None
+}
+
+fn finish(
+    entries: Vec<Entry>,
+    mut problems: Vec<Problem>,
+    source: &str,
+) -> Result<Machine, MachineError> {
+    let line_of = |key: &str| entries.iter().find(|e| e.key == key).and_then(|e| e.line);
+    let mut values = [f64::NAN; SCHEMA.len()];
+    let mut kind_seen = false;
+    let mut verify = Vec::new();
+    let mut name = String::from("unnamed");
+    // Unknown and duplicated keys.
+    for (idx, e) in entries.iter().enumerate() {
+        if entries[..idx].iter().any(|p| p.key == e.key) {
+            problems.push(Problem {
+                line: e.line,
+                key: e.key.clone(),
+                message: "given twice".into(),
+            });
+            continue;
+        }
+        if e.key == "kind" {
+            kind_seen = true;
+            match &e.value {
+                Value::Text(s) if s == "verne" => {}
+                Value::Text(s) if s == "glider" => problems.push(Problem {
+                    line: e.line,
+                    key: e.key.clone(),
+                    message: "a glider machine file was given where a VERNE machine is expected"
+                        .into(),
+                }),
+                _ => problems.push(Problem {
+                    line: e.line,
+                    key: e.key.clone(),
+                    message: "expected \"verne\"".into(),
+                }),
+            }
+            continue;
+        }
+        if let Some(name) = e.key.strip_prefix("verify.") {
+            match &e.value {
+                Value::Number(x) if x.is_finite() => verify.push((name.to_string(), *x, e.line)),
+                _ => problems.push(Problem {
+                    line: e.line,
+                    key: e.key.clone(),
+                    message: "expected a finite number (a verify threshold)".into(),
+                }),
+            }
+            continue;
+        }
+        if e.key == "name" {
+            match &e.value {
+                Value::Text(s) => name = s.clone(),
+                Value::Number(x) => name = x.to_string(),
+                Value::Other(what) => problems.push(Problem {
+                    line: e.line,
+                    key: e.key.clone(),
+                    message: format!("expected a string, found {what}"),
+                }),
+            }
+            continue;
+        }
+        let Some(pos) = SCHEMA
+            .iter()
+            .position(|(s, k, _, _)| format!("{s}.{k}") == e.key)
+        else {
+            let hint = SCHEMA
+                .iter()
+                .map(|(s, k, _, _)| format!("{s}.{k}"))
+                .find(|full| full.eq_ignore_ascii_case(&e.key))
+                .map(|full| format!(" (did you mean `{full}`?)"))
+                .unwrap_or_default();
+            let known: Vec<String> = TOP_LEVEL_KEYS
+                .iter()
+                .map(|k| k.to_string())
+                .chain(SCHEMA.iter().map(|(s, k, _, _)| format!("{s}.{k}")))
+                .collect();
+            problems.push(Problem {
+                line: e.line,
+                key: e.key.clone(),
+                message: format!("unknown key{hint}; known keys: {}", known.join(", ")),
+            });
+            continue;
+        };
+        let (_, _, check, meaning) = SCHEMA[pos];
+        let x = match &e.value {
+            Value::Number(x) => *x,
+            Value::Text(s) => {
+                problems.push(Problem {
+                    line: e.line,
+                    key: e.key.clone(),
+                    message: format!("expected a number ({meaning}), found `{s}`"),
+                });
+                continue;
+            }
+            Value::Other(what) => {
+                problems.push(Problem {
+                    line: e.line,
+                    key: e.key.clone(),
+                    message: format!("expected a number ({meaning}), found {what}"),
+                });
+                continue;
+            }
+        };
+        let bad = match check {
+            _ if !x.is_finite() => Some("must be a finite number"),
+            Check::Positive if x <= 0.0 => Some("must be a positive length"),
+            Check::TiltDegrees if !(x > 0.0 && x <= 90.0) => Some("must be in (0, 90] degrees"),
+            Check::AngleDegrees if !(-180.0..=180.0).contains(&x) => {
+                Some("must be in [-180, 180] degrees")
+            }
+            _ => None,
+        };
+        if let Some(why) = bad {
+            problems.push(Problem {
+                line: e.line,
+                key: e.key.clone(),
+                message: format!("{why} ({meaning}), found {x}"),
+            });
+            continue;
+        }
+        values[pos] = x;
+    }
+    if !kind_seen {
+        problems.push(Problem {
+            line: None,
+            key: "kind".into(),
+            message: "missing (expected kind = \"verne\")".into(),
+        });
+    }
+    for (pos, (s, k, _, meaning)) in SCHEMA.iter().enumerate() {
+        let key = format!("{s}.{k}");
+        if values[pos].is_nan() && !entries.iter().any(|e| e.key == key) {
+            problems.push(Problem {
+                line: None,
+                key,
+                message: format!("missing required key ({meaning})"),
+            });
+        }
+    }
+    problems.sort_by_key(|p| p.line.unwrap_or(usize::MAX));
+    if !problems.is_empty() {
+        return Err(MachineError {
+            source: source.to_string(),
+            problems,
+        });
+    }
+    let v = |i: usize| values[i];
+    let machine = Machine {
+        name,
+        module: ModuleGeometry {
+            dx1: v(0) - v(1),
+            r_big1: v(2),
+            r_small1: v(3),
+            l1: v(4),
+            dx2: v(5) - v(6),
+            r_big2: v(7),
+            r4: v(8),
+            l2: v(9),
+            l3: v(10),
+        },
+        limits: Limits {
+            rho_min: [v(11), v(13), v(15)],
+            rho_max: [v(12), v(14), v(16)],
+            rod_tilt_max: v(17).to_radians(),
+            cos_rod_tilt_max: (v(17).to_radians() + crate::tolerance::LIMIT_SLACK).cos(),
+            theta1_min: v(18).to_radians(),
+            theta1_max: v(19).to_radians(),
+        },
+        table: TableGeometry {
+            d_a: v(20),
+            d_t: v(21),
+        },
+        tool_length: v(22),
+        verify,
+    };
+    let cross = machine.cross_checks(&line_of);
+    if cross.is_empty() {
+        Ok(machine)
+    } else {
+        Err(MachineError {
+            source: source.to_string(),
+            problems: cross,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::spec::DEFAULT_MACHINE_TOML;
+
+    #[test]
+    fn default_machine_matches_reference_geometry() {
+        let m = Machine::default_verne();
+        assert_eq!(m.module.dx1, -320.0);
+        assert_eq!(m.module.r_big1, 130.0);
+        assert_eq!(m.module.r_small1, 80.0);
+        assert_eq!(m.module.l1, 850.0);
+        assert_eq!(m.module.dx2, 240.74);
+        assert_eq!(m.module.r_big2, 190.11);
+        assert_eq!(m.module.r4, 565.37);
+        assert_eq!(m.module.l2, 950.30);
+        assert_eq!(m.module.l3, 950.46);
+        assert_eq!(m.tool_length, 50.0);
+        assert!((m.limits.rod_tilt_max - 60f64.to_radians()).abs() < 1e-15);
+    }
+
+    #[test]
+    fn toml_round_trips_through_to_toml() {
+        let m = Machine::default_verne();
+        let again = Machine::from_toml_str(&m.to_toml(), "x").unwrap();
+        assert_eq!(m, again);
+    }
+
+    #[test]
+    fn csv_and_toml_agree() {
+        let m = Machine::default_verne();
+        let mut csv = String::from("key,value\nkind,verne\nname,VERNE\n");
+        let table: toml::Table = DEFAULT_MACHINE_TOML.parse().unwrap();
+        for (s, v) in &table {
+            if let toml::Value::Table(t) = v {
+                for (k, x) in t {
+                    csv.push_str(&format!("{s}.{k},{x}\n"));
+                }
+            }
+        }
+        assert_eq!(Machine::from_str_auto(&csv, "m.csv").unwrap(), m);
+    }
+
+    #[test]
+    fn every_problem_is_reported_with_its_line() {
+        let text = DEFAULT_MACHINE_TOML
+            .replace("R1 = 130.0", "R1 = -130.0")
+            .replace("L2 = 950.30", "L2 = \"long\"")
+            .replace("length = 50.0", "length = 50.0\nlenght = 3");
+        let text = text.replace(
+            "r4 = 565.37   # half-distance between the leg-II and leg-III sliders\n",
+            "",
+        );
+        let err = Machine::from_toml_str(&text, "bad.toml").unwrap_err();
+        let keys: Vec<&str> = err.problems.iter().map(|p| p.key.as_str()).collect();
+        assert!(keys.contains(&"module.R1"), "{err}");
+        assert!(keys.contains(&"module.L2"), "{err}");
+        assert!(keys.contains(&"tool.lenght"), "{err}");
+        assert!(keys.contains(&"module.r4"), "{err}");
+        let r1 = err.problems.iter().find(|p| p.key == "module.R1").unwrap();
+        let expected_line = text.lines().position(|l| l.starts_with("R1 =")).unwrap() + 1;
+        assert_eq!(r1.line, Some(expected_line));
+        assert!(err.to_string().contains("bad.toml:"));
+    }
+
+    #[test]
+    fn crossing_rods_and_short_rods_are_rejected() {
+        let text = DEFAULT_MACHINE_TOML.replace("r1 = 80.0", "r1 = 200.0");
+        let err = Machine::from_toml_str(&text, "m").unwrap_err();
+        assert!(err.to_string().contains("always cross"), "{err}");
+        let text = DEFAULT_MACHINE_TOML.replace("L1 = 850.0", "L1 = 40.0");
+        let err = Machine::from_toml_str(&text, "m").unwrap_err();
+        assert!(err.to_string().contains("too short"), "{err}");
+    }
+}

@@ -1,0 +1,354 @@
+//! The checks of one segment between two rows, with the joints interpolated linearly as a
+//! controller does: branch changes, theta2 flips, joint jumps, velocities, and along the
+//! interpolated joints the assembly mode, rod tilts, singularity proximity and the chordal error.
+
+use super::row::{ROD_NAMES, exceeds, max_tilt, singularity_checks};
+use super::*;
+
+/// The module pose at sliders `rho`, continued from `prev` (Newton; if it fails, the nearest
+/// assembly mode of the forward kinematics). None when the sliders cannot be assembled.
+fn track(m: &Machine, prev: &ModulePose, rho: &Sliders) -> Option<ModulePose> {
+    let g = &m.module;
+    let p = polish_pose(g, *prev, rho);
+    if residual_mm(g, &p, rho) <= ACCEPT_RESIDUAL_MM {
+        return Some(p);
+    }
+    crate::parallel_module::fk::solve(m, rho)
+        .iter()
+        .map(|md| md.pose)
+        .min_by(|a, b| pose_distance(g, a, prev).total_cmp(&pose_distance(g, b, prev)))
+}
+
+fn pose_distance(g: &crate::spec::ModuleGeometry, a: &ModulePose, b: &ModulePose) -> f64 {
+    (a.p - b.p)
+        .amax()
+        .max((wrap_angle(a.alpha - b.alpha) * g.r_big2).abs())
+}
+
+/// Segment checks that need only its two rows (run in parallel).
+pub(super) fn eval_segment(m: &Machine, opt: &VerifyOptions, a: &RowEval, b: &RowEval) -> SegEval {
+    let th = &opt.thresholds;
+    let mut s = SegEval::default();
+    let (Some(qa), Some(qb), Some(pa), Some(pb)) = (a.q, b.q, a.point, b.point) else {
+        return s;
+    };
+    let row = b.label.as_str();
+    let from = format!("segment from row {}", a.label);
+    let dq: [f64; 5] = std::array::from_fn(|i| qb.as_array()[i] - qa.as_array()[i]);
+    let dtheta2 = dq[4];
+    // 4. A change of orientation solution that is not a passage through the table normal.
+    let (la, lb) = (orientation_label(a.phi1), orientation_label(b.phi1));
+    if la * lb == -1 && wrap_angle(dtheta2).abs() > ORIENTATION_FLIP_RAD {
+        s.violations.push(Violation::over(
+            row,
+            Check::Branch,
+            wrap_angle(dtheta2).abs().to_degrees(),
+            ORIENTATION_FLIP_RAD.to_degrees(),
+            format!(
+                "{from}: orientation solution {} -> {} (phi1 {:.4} -> {:.4} deg, theta2 {:+.4} deg, theta1 {:+.4} deg)",
+                if la > 0 { 1 } else { 2 },
+                if lb > 0 { 1 } else { 2 },
+                a.phi1.to_degrees(),
+                b.phi1.to_degrees(),
+                dtheta2.to_degrees(),
+                dq[3].to_degrees()
+            ),
+        ));
+        return s;
+    }
+    // 6. theta2 flip: about half a turn (mod a full turn).
+    let turns = dtheta2.abs() % (2.0 * PI);
+    if (turns - PI).abs() < th.get(Th::Theta2FlipTolDeg).to_radians() {
+        s.violations.push(Violation::over(
+            row,
+            Check::Theta2Flip,
+            dtheta2.abs().to_degrees(),
+            th.get(Th::Theta2StepDeg),
+            format!(
+                "{from}: theta2 {:.4} -> {:.4} deg ({:+.4} deg)",
+                qa.theta2.to_degrees(),
+                qb.theta2.to_degrees(),
+                dtheta2.to_degrees()
+            ),
+        ));
+        s.flip = Some(dtheta2);
+        return s;
+    }
+    // 6. Joint jumps.
+    let step = th.per_joint(Th::RhoStepMm, Th::Theta1StepDeg, Th::Theta2StepDeg);
+    let mut jumped = false;
+    let mut worst = None;
+    for i in 0..5 {
+        let (v, l) = if i < 3 {
+            (dq[i].abs(), step[i])
+        } else {
+            (dq[i].abs().to_degrees(), step[i].to_degrees())
+        };
+        keep_worst(
+            &mut worst,
+            Obs::over(Check::JointJump, v, l, JOINT_NAMES[i]),
+        );
+        if dq[i].abs() > step[i] {
+            let (v, l, u) = if i < 3 {
+                (dq[i].abs(), step[i], "mm")
+            } else {
+                (dq[i].abs().to_degrees(), step[i].to_degrees(), "deg")
+            };
+            s.violations.push(Violation::over(
+                row,
+                Check::JointJump,
+                v,
+                l,
+                format!(
+                    "{from}: {} changes by {:+.4} {u}",
+                    JOINT_NAMES[i],
+                    if i < 3 { dq[i] } else { dq[i].to_degrees() }
+                ),
+            ));
+            jumped = true;
+        }
+    }
+    s.obs.extend(worst);
+    if jumped {
+        return s;
+    }
+    // 6. Velocities.
+    let dt = match (qa.t, qb.t, qb.feed) {
+        (Some(ta), Some(tb), _) => Some(tb - ta),
+        (_, _, Some(f)) if f > 0.0 => Some((pb.tip - pa.tip).norm() / f),
+        _ => None,
+    };
+    if let Some(dt) = dt {
+        s.dt = dt;
+        if qa.t.is_some() && dt <= 0.0 {
+            s.violations.push(Violation::plain(
+                row,
+                Check::Velocity,
+                dt,
+                format!("{from}: t does not increase (dt = {dt} s)"),
+            ));
+        } else if dt > 0.0 {
+            let vmax = th.per_joint(
+                Th::RhoVelocityMmS,
+                Th::Theta1VelocityDegS,
+                Th::Theta2VelocityDegS,
+            );
+            let rates: [f64; 5] = std::array::from_fn(|i| dq[i] / dt);
+            let mut ok = true;
+            let mut worst = None;
+            for i in 0..5 {
+                let (v, l) = if i < 3 {
+                    (rates[i].abs(), vmax[i])
+                } else {
+                    (rates[i].abs().to_degrees(), vmax[i].to_degrees())
+                };
+                keep_worst(&mut worst, Obs::over(Check::Velocity, v, l, JOINT_NAMES[i]));
+                if rates[i].abs() > vmax[i] {
+                    let (v, l, u) = if i < 3 {
+                        (rates[i].abs(), vmax[i], "mm/s")
+                    } else {
+                        (rates[i].abs().to_degrees(), vmax[i].to_degrees(), "deg/s")
+                    };
+                    s.violations.push(Violation::over(
+                        row,
+                        Check::Velocity,
+                        v,
+                        l,
+                        format!("{from}: {} at {v:.4} {u} (dt = {dt:.6} s)", JOINT_NAMES[i]),
+                    ));
+                    ok = false;
+                }
+            }
+            s.obs.extend(worst);
+            if ok {
+                s.rates = Some(rates);
+            }
+        }
+    }
+    // 2, 3, 4, 5 along the interpolated joints.
+    interior(m, opt, a, b, &qa, &qb, &pa, &pb, &from, &mut s);
+    s
+}
+
+/// Samples a segment's interior: assembly mode, rod tilts, singularity, chordal error.
+#[allow(clippy::too_many_arguments)]
+fn interior(
+    m: &Machine,
+    opt: &VerifyOptions,
+    a: &RowEval,
+    b: &RowEval,
+    qa: &Joints,
+    qb: &Joints,
+    pa: &PathPoint,
+    pb: &PathPoint,
+    from: &str,
+    seg: &mut SegEval,
+) {
+    let out = &mut seg.violations;
+    let mut singular_worst: Option<Obs> = None;
+    let mut tilt_worst: Option<Obs> = None;
+    let th = &opt.thresholds;
+    let row = b.label.as_str();
+    let g = &m.module;
+    let drho = qb.rho - qa.rho;
+    let travel = drho.amax();
+    let half =
+        ((travel / (2.0 * SEGMENT_SAMPLE_MM)).ceil() as usize).clamp(1, MAX_SEGMENT_SAMPLES / 2);
+    let n = 2 * half;
+    let tilt_limit = m.limits.rod_tilt_max;
+    let check_tilt = a.tilt_ok && b.tilt_ok;
+    let check_singular = a.singular_ok && b.singular_ok;
+    let mut pose = a.module;
+    // (s, rod, tilt) of the worst sample, and the tilts either side of it.
+    let mut worst: Option<(usize, usize, f64, ModulePose)> = None;
+    let mut tilts_prev = max_tilt(m, &a.module, &qa.rho).1;
+    let mut around = [f64::NAN; 3];
+    let mut singular: Vec<Violation> = Vec::new();
+    for j in 1..n {
+        let s = j as f64 / n as f64;
+        let rho = qa.rho + drho * s;
+        let Some(next) = track(m, &pose, &rho) else {
+            out.push(Violation::plain(
+                row,
+                Check::Branch,
+                s,
+                format!("{from}: the interpolated joints cannot be assembled at s = {s:.4}"),
+            ));
+            return;
+        };
+        pose = next;
+        let config = config_of(g, &pose, &rho);
+        if !machine_kind(config, pose.alpha, m) {
+            out.push(Violation::plain(
+                row,
+                Check::Branch,
+                s,
+                format!(
+                    "{from}: leaves the machine's assembly mode at s = {s:.4} (s = ({},{},{}), alpha = {:.4} deg)",
+                    config[0],
+                    config[1],
+                    config[2],
+                    pose.alpha.to_degrees()
+                ),
+            ));
+            return;
+        }
+        if j == half {
+            let q1 = qa.theta1 + (qb.theta1 - qa.theta1) * 0.5;
+            let q2 = qa.theta2 + (qb.theta2 - qa.theta2) * 0.5;
+            let tip = tool_pose_eq26(&m.table, &pose, q1, q2, opt.tool_length).tip;
+            let chord = (tip - (pa.tip + pb.tip) * 0.5).norm();
+            seg.obs.push(Obs::over(
+                Check::ChordError,
+                chord,
+                th.get(Th::ChordErrorMm),
+                "chordal error",
+            ));
+            if exceeds(chord, th.get(Th::ChordErrorMm)) {
+                out.push(Violation::over(
+                    row,
+                    Check::ChordError,
+                    chord,
+                    th.get(Th::ChordErrorMm),
+                    format!(
+                        "{from}: tip at the joints' midpoint is {chord:.5} mm off the intended line"
+                    ),
+                ));
+            }
+        }
+        if check_tilt {
+            let (rod, t) = max_tilt(m, &pose, &rho);
+            keep_worst(
+                &mut tilt_worst,
+                Obs::over(
+                    Check::Limits,
+                    t.to_degrees(),
+                    tilt_limit.to_degrees(),
+                    "largest rod tilt, mid-segment",
+                ),
+            );
+            if let Some((wj, _, _, _)) = worst
+                && wj + 1 == j
+            {
+                around[2] = t;
+            }
+            if t > tilt_limit && worst.as_ref().is_none_or(|w| t > w.2) {
+                worst = Some((j, rod, t, pose));
+                around = [tilts_prev, t, f64::NAN];
+            }
+            tilts_prev = t;
+        }
+        if check_singular && singular.is_empty() {
+            let o = singularity_checks(
+                m,
+                th,
+                &pose,
+                &rho,
+                row,
+                &format!("{from}, at s = {s:.4}: "),
+                &mut singular,
+            );
+            keep_worst(
+                &mut singular_worst,
+                Obs {
+                    what: "mid-segment",
+                    ..o
+                },
+            );
+        }
+    }
+    seg.obs.extend(singular_worst);
+    seg.obs.extend(tilt_worst);
+    let out = &mut seg.violations;
+    // The tracked mode must arrive at the end row's mode.
+    let end = track(m, &pose, &qb.rho);
+    let arrived = end.is_some_and(|p| pose_distance(g, &p, &b.module) <= TRACK_ARRIVAL_MM);
+    if !arrived {
+        out.push(Violation::plain(
+            row,
+            Check::Branch,
+            1.0,
+            format!(
+                "{from}: the interpolated joints arrive in another assembly mode than the row's"
+            ),
+        ));
+        return;
+    }
+    if let Some((j, rod, t, wpose)) = worst {
+        if around[2].is_nan() {
+            around[2] = max_tilt(m, &b.module, &qb.rho).1;
+        }
+        // Parabola through the worst sample and its neighbours: refine the maximum.
+        let (f0, f1, f2) = (around[0], around[1], around[2]);
+        let den = f0 - 2.0 * f1 + f2;
+        let mut best = (j as f64 / n as f64, t, rod);
+        if den < 0.0 {
+            let off = 0.5 * (f0 - f2) / den;
+            if off.abs() < 1.0 {
+                let s = (j as f64 + off) / n as f64;
+                let rho = qa.rho + drho * s;
+                if let Some(p) = track(m, &wpose, &rho) {
+                    let (r2, t2) = max_tilt(m, &p, &rho);
+                    if t2 > best.1 {
+                        best = (s, t2, r2);
+                    }
+                }
+            }
+        }
+        out.push(Violation::over(
+            row,
+            Check::Limits,
+            best.1.to_degrees(),
+            tilt_limit.to_degrees(),
+            format!(
+                "{from}: mid-segment, rod {} tilted {:.4} deg at s = {:.4} (ends {:.4} and {:.4} deg)",
+                ROD_NAMES[best.2],
+                best.1.to_degrees(),
+                best.0,
+                max_tilt(m, &a.module, &qa.rho).1.to_degrees(),
+                max_tilt(m, &b.module, &qb.rho).1.to_degrees()
+            ),
+        ));
+    }
+    out.extend(singular);
+}

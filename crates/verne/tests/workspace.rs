@@ -1,0 +1,258 @@
+//! Workspace invariants: every inside point round-trips through the forward kinematics, the
+//! points just outside fail the constraint named binding (checked from the rod geometry, not
+//! from the classifier), the volume converges as the step halves, the result does not depend on
+//! the thread count (the pictures and the command: crates/verne-cli/tests/cli_workspace.rs).
+
+use nalgebra::Vector3;
+use verne::parallel_module::branches::WORKING_CONFIG;
+use verne::parallel_module::equations::{ModulePose, rod_vectors};
+use verne::parallel_module::fk;
+use verne::parallel_module::ik;
+use verne::parallel_module::kinetostatics::kinetostatics;
+use verne::spec::Machine;
+use verne::workspace::{
+    self, Bounds, Constraint, Of, Outcome, PAPER_LAMBDA_BOUNDS, PointResult, Workspace,
+    WorkspaceOptions,
+};
+
+/// FK pose against the pose the workspace reported (mm; rad for alpha).
+const ROUND_TRIP_MM: f64 = 1e-6;
+const ROUND_TRIP_RAD: f64 = 1e-9;
+
+fn options(of: Of, tool_length: f64, step: f64) -> WorkspaceOptions {
+    WorkspaceOptions {
+        of,
+        tool_length,
+        step,
+        bounds: None,
+        lambda: PAPER_LAMBDA_BOUNDS,
+    }
+}
+
+fn run(m: &Machine, opts: &WorkspaceOptions) -> (Workspace, Vec<PointResult>) {
+    let mut points = Vec::new();
+    let ws = workspace::compute::<()>(m, opts, &|_| {}, |r| {
+        points.push(*r);
+        Ok(())
+    })
+    .unwrap()
+    .unwrap();
+    (ws, points)
+}
+
+#[test]
+fn every_inside_point_round_trips_through_the_forward_kinematics() {
+    let m = Machine::default_verne();
+    for (of, delta, step) in [
+        (Of::Platform, 0.0, 40.0),
+        (Of::Tool, 100.0, 40.0),
+        (Of::Manufacturing, 50.0, 50.0),
+    ] {
+        let (ws, points) = run(&m, &options(of, delta, step));
+        assert!(ws.summary.inside > 100, "{of:?}: {}", ws.summary.inside);
+        for r in points.iter().filter(|r| r.outcome == Outcome::Inside) {
+            let b = r.branch.unwrap();
+            let modes = fk::solve(&m, &b.rho);
+            let found = modes.iter().find(|md| {
+                md.config == WORKING_CONFIG
+                    && (md.pose.p - b.pose.p).amax() < ROUND_TRIP_MM
+                    && (md.pose.alpha - b.pose.alpha).abs() < ROUND_TRIP_RAD
+            });
+            let md = found.unwrap_or_else(|| {
+                panic!(
+                    "{of:?} {}: rho {} not returned by FK: {modes:?}",
+                    r.q, b.rho
+                )
+            });
+            // The FK pose gives back the grid point through eq. (27) or eq. (26).
+            let q = workspace::grid_point_of(&m, of, delta, &md.pose.p, md.pose.alpha);
+            assert!((q - r.q).amax() < ROUND_TRIP_MM, "{of:?}: {q} vs {}", r.q);
+            // And the machine's own choice of assembly mode is that pose.
+            let w = fk::working(&modes).unwrap();
+            assert!((w.pose.p - b.pose.p).amax() < ROUND_TRIP_MM);
+        }
+    }
+}
+
+/// Whether the branch (pose, rho) fails constraint `c`, from the rod geometry directly.
+fn fails(
+    m: &Machine,
+    of: Of,
+    pose: &ModulePose,
+    rho: &nalgebra::Vector3<f64>,
+    c: Constraint,
+) -> bool {
+    let g = &m.module;
+    let slack = 1e-9;
+    match c {
+        Constraint::RodsCross => g.r_big1 * pose.alpha.cos() <= g.r_small1,
+        Constraint::RodTilt => rod_vectors(g, pose, rho)
+            .iter()
+            .any(|v| (v.z / v.norm()).acos() > m.limits.rod_tilt_max + slack),
+        Constraint::Singularity => !kinetostatics(g, pose, rho)
+            .amplification_within(PAPER_LAMBDA_BOUNDS[0], PAPER_LAMBDA_BOUNDS[1]),
+        Constraint::Stroke => (0..3)
+            .any(|i| rho[i] < m.limits.rho_min[i] - slack || rho[i] > m.limits.rho_max[i] + slack),
+        Constraint::Theta1Range => {
+            of == Of::Manufacturing
+                && (pose.alpha < m.limits.theta1_min - slack
+                    || pose.alpha > m.limits.theta1_max + slack)
+        }
+    }
+}
+
+#[test]
+fn points_just_outside_fail_the_constraint_named_binding() {
+    let m = Machine::default_verne();
+    for (of, delta, step) in [
+        (Of::Platform, 0.0, 30.0),
+        (Of::Tool, 150.0, 40.0),
+        (Of::Manufacturing, 50.0, 40.0),
+    ] {
+        let (ws, points) = run(&m, &options(of, delta, step));
+        let g = ws.map.grid;
+        let mut boundary = 0;
+        let mut seen = std::collections::HashSet::new();
+        for k in 0..g.n[2] {
+            for j in 0..g.n[1] {
+                for i in 0..g.n[0] {
+                    let r = &points[g.index(i, j, k)];
+                    if r.outcome == Outcome::Inside {
+                        continue;
+                    }
+                    let near_inside = [
+                        (1i64, 0i64, 0i64),
+                        (-1, 0, 0),
+                        (0, 1, 0),
+                        (0, -1, 0),
+                        (0, 0, 1),
+                        (0, 0, -1),
+                    ]
+                    .iter()
+                    .any(|&(di, dj, dk)| {
+                        let (a, b, c) = (i as i64 + di, j as i64 + dj, k as i64 + dk);
+                        a >= 0
+                            && b >= 0
+                            && c >= 0
+                            && (a as usize) < g.n[0]
+                            && (b as usize) < g.n[1]
+                            && (c as usize) < g.n[2]
+                            && ws.map.at(a as usize, b as usize, c as usize) == Outcome::Inside
+                    });
+                    if !near_inside {
+                        continue;
+                    }
+                    boundary += 1;
+                    let Outcome::Bound(c) = r.outcome else {
+                        // Out of reach next to an inside point: no s=(-1,-1,-1) branch at P
+                        // (platform: P is the grid point itself).
+                        if of == Of::Platform {
+                            assert!(
+                                ik::solve(&m, &r.q)
+                                    .iter()
+                                    .all(|b| b.config != WORKING_CONFIG)
+                            );
+                        }
+                        continue;
+                    };
+                    seen.insert(c);
+                    let b = r.branch.unwrap();
+                    // The reported branch is a real s=(-1,-1,-1) IK branch of its P ...
+                    let ik = ik::solve(&m, &b.pose.p);
+                    let same = ik.iter().find(|x| {
+                        x.config == WORKING_CONFIG
+                            && (x.alpha - b.pose.alpha).abs() < 1e-9
+                            && (x.rho - b.rho).amax() < 1e-6
+                    });
+                    assert!(same.is_some(), "{of:?} {}: branch not an IK branch", r.q);
+                    // ... whose grid point is this one ...
+                    let q = workspace::grid_point_of(&m, of, delta, &b.pose.p, b.pose.alpha);
+                    assert!((q - r.q).amax() < 1e-6);
+                    // ... and which fails the binding constraint, and none before it.
+                    assert!(
+                        fails(&m, of, &b.pose, &b.rho, c),
+                        "{of:?} {}: does not fail {c:?}",
+                        r.q
+                    );
+                    for earlier in Constraint::ALL.iter().take_while(|&&x| x != c) {
+                        assert!(
+                            !fails(&m, of, &b.pose, &b.rho, *earlier),
+                            "{of:?} {}: fails {earlier:?} before {c:?}",
+                            r.q
+                        );
+                    }
+                    // For the platform, no s=(-1,-1,-1) branch of P satisfies every constraint.
+                    if of == Of::Platform {
+                        for x in ik.iter().filter(|x| x.config == WORKING_CONFIG) {
+                            let pose = ModulePose {
+                                p: r.q,
+                                alpha: x.alpha,
+                            };
+                            assert!(
+                                Constraint::ALL
+                                    .iter()
+                                    .any(|&c| fails(&m, of, &pose, &x.rho, c))
+                            );
+                        }
+                    }
+                }
+            }
+        }
+        assert!(boundary > 50, "{of:?}: {boundary} boundary points");
+        assert!(!seen.is_empty());
+    }
+}
+
+#[test]
+fn volume_converges_as_the_step_halves() {
+    let m = Machine::default_verne();
+    // A fixed box around the platform workspace, its edges multiples of every step.
+    let bounds = Bounds {
+        min: Vector3::new(-420.0, -480.0, 780.0),
+        max: Vector3::new(540.0, 480.0, 1980.0),
+    };
+    let vols: Vec<f64> = [60.0, 30.0, 15.0]
+        .iter()
+        .map(|&h| {
+            let opts = WorkspaceOptions {
+                bounds: Some(bounds),
+                ..options(Of::Platform, 0.0, h)
+            };
+            let (ws, _) = run(&m, &opts);
+            assert!(!ws.summary.touches_bounds);
+            ws.summary.volume_mm3
+        })
+        .collect();
+    let d1 = (vols[1] - vols[0]).abs();
+    let d2 = (vols[2] - vols[1]).abs();
+    eprintln!("volumes {vols:?} mm^3, differences {d1} then {d2}");
+    assert!(d2 < d1, "{vols:?}");
+    assert!(d2 < 0.01 * vols[2], "{vols:?}");
+}
+
+#[test]
+fn the_summary_does_not_depend_on_the_thread_count() {
+    let m = Machine::default_verne();
+    let opts = options(Of::Manufacturing, 50.0, 40.0);
+    let on = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| run(&m, &opts))
+    };
+    let (a, pa) = on(1);
+    let (b, pb) = on(2);
+    assert_eq!(a.summary, b.summary);
+    assert_eq!(a.map, b.map);
+    assert_eq!(pa, pb);
+}
+
+#[test]
+fn a_zero_length_tool_has_the_platform_workspace() {
+    let m = Machine::default_verne();
+    let (p, _) = run(&m, &options(Of::Platform, 0.0, 40.0));
+    let (t, _) = run(&m, &options(Of::Tool, 0.0, 40.0));
+    assert_eq!(p.map.outcome, t.map.outcome);
+    assert_eq!(p.summary.volume_mm3, t.summary.volume_mm3);
+}
