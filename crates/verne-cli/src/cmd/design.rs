@@ -8,9 +8,9 @@ use verne::glider::{
     Architecture, DesignOptions, PAPER_LAMBDA_BOUNDS, Table1Row, Table2Row, table1_row, table2,
 };
 
-use super::glider::{aligned, csv_text};
 use super::{EXIT_OK, EXIT_ROWS_FAILED, write_stdout};
 use crate::cli::DesignArgs;
+use crate::report::text_table::{aligned, csv_text};
 
 /// Bounds within this relative difference of 1/3 and 3 are the paper's, and its values apply.
 /// Dimensionless.

@@ -12,7 +12,7 @@ use std::arch::x86_64::*;
 
 use nalgebra::Vector3;
 
-use super::{IkBranch, IkBranches, Leg1, posture_order};
+use super::branch::{IkBranch, IkBranches, Leg1, posture_order};
 use crate::parallel_module::branches::{Reason, Verdict};
 use crate::parallel_module::equations::Sliders;
 use crate::spec::Machine;

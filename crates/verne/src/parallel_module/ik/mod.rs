@@ -10,21 +10,22 @@
 //! by side ([`solve_each`], [`solve_working_each`]; [`LANES`] at a time), each alone all the
 //! same, so that the processor overlaps their chains of square roots and divisions.
 
+mod branch;
 #[cfg(target_arch = "x86_64")]
 mod lanes;
 
 use arrayvec::ArrayVec;
 use nalgebra::Vector3;
 
-use crate::certificate::{Certificate, Certified};
+use crate::certificate::Certificate;
 use crate::math::cpu;
 use crate::math::cubic::{cubic_roots_in, cubic_roots_in_with_error, deflated_roots_in};
 use crate::math::dd::Tracked;
 use crate::math::scalar::Mag;
 use crate::math::trig::{SMALL_ANGLE, sin_cos_after_step, sin_cos_small};
 use crate::parallel_module::branches::{
-    Config, Verdict, WORKING_CONFIG, cos_tilt_max, leg_state, listed_in_order, outer_leg_labels,
-    outer_leg_states, rods_cross, stroke_verdict,
+    Verdict, WORKING_CONFIG, cos_tilt_max, leg_state, outer_leg_labels, outer_leg_states,
+    rods_cross, stroke_verdict,
 };
 use crate::parallel_module::equations::Sliders;
 use crate::spec::{Machine, ModuleGeometry};
@@ -33,36 +34,8 @@ use crate::tolerance::{
     NEWTON_MAX_ITER, NEWTON_STEP_STOP, SAME_SOLUTION_RAD, SIN_ALPHA_ZERO, SQRT_ARG_REL,
 };
 
-/// Most branches one point can have: three roots of eq. (9), two alphas each, two rho2, two rho3.
-pub const MAX_IK_BRANCHES: usize = 24;
-
-/// One inverse-kinematics branch.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct IkBranch {
-    pub alpha: f64,
-    pub rho: Sliders,
-    pub config: Config,
-    pub verdict: Verdict,
-}
-
-impl IkBranch {
-    pub fn working(&self) -> bool {
-        self.verdict.feasible()
-    }
-}
-
-/// Every inverse-kinematics branch of one point, with the certificate that says why there are
-/// no others.
-pub type IkBranches = Certified<IkBranch, MAX_IK_BRANCHES>;
-
-/// A leg-I posture: an orientation alpha and the slider-1 position that goes with it.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Leg1 {
-    pub alpha: f64,
-    pub rho1: f64,
-    pub sin: f64,
-    pub cos: f64,
-}
+pub use branch::{IkBranch, IkBranches, MAX_IK_BRANCHES};
+pub(crate) use branch::{Leg1, posture_order};
 
 /// The cubic eq. (9) in cos(alpha) for the point, normalised, lowest degree first; None when it
 /// is degenerate (every coefficient zero or not finite).
@@ -845,40 +818,6 @@ fn branches_into(m: &Machine, p: &Vector3<f64>, legs1: &ArrayVec<Leg1, 6>, out: 
             );
         }
     }
-}
-
-/// The order in which the branches of the leg-I postures `legs1` come out, with their leg-I
-/// configuration indices `s1`: the first `legs1.len()` entries, indices into `legs1`.
-/// Branches come out ordered by alpha, then (s1, s2, s3): postures sorted by (alpha, s1), and
-/// within a posture s2, s3 = -1 before +1 (the roots of (12)-(13) in increasing order).
-/// Postures come in pairs (alpha >= 0, its mirror) by increasing cos(alpha): the mirrors in
-/// that order, then the others in reverse, is usually the order already; sorted if not.
-#[inline(always)]
-pub(crate) fn posture_order(legs1: &[Leg1], s1: &[i8; 6]) -> ([usize; 6], usize) {
-    let n = legs1.len().min(6);
-    let mut order = [0usize; 6];
-    let (mut front, mut back) = (0, n);
-    for (k, leg1) in legs1[..n].iter().enumerate() {
-        if leg1.alpha < 0.0 {
-            order[front] = k;
-            front += 1;
-        } else {
-            back -= 1;
-            order[back] = k;
-        }
-    }
-    let listed = &mut order[..n];
-    let in_order = listed
-        .windows(2)
-        .all(|w| listed_in_order((legs1[w[0]].alpha, s1[w[0]]), (legs1[w[1]].alpha, s1[w[1]])));
-    if !in_order {
-        let key = |k: usize| (legs1[k].alpha, s1[k]);
-        listed.sort_unstable_by(|&a, &b| {
-            let (ka, kb) = (key(a), key(b));
-            ka.0.total_cmp(&kb.0).then(ka.1.cmp(&kb.1))
-        });
-    }
-    (order, n)
 }
 
 /// Legs II and III at a leg-I posture as far as they depend on its cos(alpha) alone (a posture

@@ -1,10 +1,13 @@
 //! Pictures (SVG or PNG, by the file's extension, drawn with plotters): workspace slices and
 //! projections coloured by binding constraint, and schematics of the branches of one query
-//! (sliders, rods, platform; compare Figs. 5-6, AIM 2007).
+//! (sliders, rods, platform; compare Figs. 5-6, AIM 2007); the glider workspace's SVG is in
+//! [`glider`].
 //!
 //! Files are written to a temporary file beside the target and renamed into place. PNG text is
 //! drawn with DejaVu Sans, embedded from `assets/fonts/` (Bitstream Vera licence, which allows
 //! redistribution with software; see `assets/fonts/LICENSE-DejaVu.txt`).
+
+pub mod glider;
 
 use std::path::{Path, PathBuf};
 use std::sync::Once;
@@ -17,7 +20,7 @@ use verne::parallel_module::equations::{ModulePose, Sliders, rod_vectors};
 use verne::spec::Machine;
 use verne::workspace::{Bounds, Outcome, OutcomeGrid, WorkspaceSummary};
 
-const FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
+const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 const FAMILY: &str = "sans-serif";
 static REGISTER: Once = Once::new();
 

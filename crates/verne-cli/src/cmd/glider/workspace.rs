@@ -1,0 +1,368 @@
+//! `verne workspace -m GLIDER`: the Cartesian workspace of a glider (section 2.6, Wenger 2001),
+//! the points CSV, the SVG picture and the summary on stderr (docs/gliders.md).
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use csv::ByteRecord;
+use verne::glider::{
+    GliderSpec, NodeClass, Rectangle, WorkspaceGrid, WorkspaceOptions, amplification, branch_label,
+    inverse_kinematics_in_mode, largest_rectangle, largest_square, mode_label, sample_workspace,
+};
+
+use crate::cmd::{EXIT_OK, EXIT_ROWS_FAILED};
+use crate::engine::pipeline::{Cell, Units, write_cell};
+use crate::error::VerneError;
+use crate::plot::glider::workspace_svg;
+use crate::table::Sink;
+
+/// Default grid nodes along the longer side of the workspace window.
+pub const WORKSPACE_DEFAULT_NODES: usize = 801;
+
+/// Most grid nodes along one side of a workspace (memory: 2 bytes per node).
+pub const WORKSPACE_MAX_NODES: usize = 10_001;
+
+/// Header of the workspace points CSV.
+pub const WORKSPACE_HEADER: [&str; 8] = [
+    "x", "y", "rho1", "rho2", "lambda1", "lambda2", "status", "region",
+];
+
+fn class_code(c: NodeClass) -> &'static str {
+    match c {
+        NodeClass::Unreachable => "unreachable",
+        NodeClass::OutOfRange => "out_of_range",
+        NodeClass::Singular => "singular",
+        NodeClass::OtherAssembly => "other_assembly",
+        NodeClass::OutOfBounds => "out_of_bounds",
+        NodeClass::Admissible => "admissible",
+    }
+}
+
+/// Cartesian workspace of a glider in working mode `++` (section 2.6, Wenger 2001): every node
+/// of a square grid over the image of the joint box is classified (reached within the joint
+/// ranges, singular, other assembly mode, outside the amplification bounds, admissible); the
+/// t-connected region is the admissible nodes 4-connected to the forward kinematics of the
+/// centre of the joint box; S is the largest rectangle in it, sides at 0 or 45 deg
+/// (docs/gliders.md).
+///
+/// - `step`: grid step in the spec's length unit; `nodes`: grid nodes along the longer side of
+///   the window (default [`WORKSPACE_DEFAULT_NODES`]); give at most one.
+/// - `lambda_bounds`: eq. (4) bounds on both amplification factors (`Some(PAPER_LAMBDA_BOUNDS)`
+///   for the paper's 1/3 < lambda < 3), `None` for none.
+/// - `output`: the points CSV ([`WORKSPACE_HEADER`], one row per node, y slowest), written
+///   atomically; `None` writes no points, `-` writes stdout.
+/// - `plot`: an SVG picture of the workspace, the region, the rectangle and the guides.
+///
+/// The summary goes to stderr. Returns exit code 0, or 1 when the region is empty.
+pub fn workspace(
+    spec: &GliderSpec,
+    step: Option<f64>,
+    nodes: Option<usize>,
+    lambda_bounds: Option<[f64; 2]>,
+    output: Option<&Path>,
+    plot: Option<&Path>,
+    units: Units,
+) -> Result<u8, VerneError> {
+    if let Some([lo, hi]) = lambda_bounds
+        && !(lo.is_finite() && hi.is_finite() && lo > 0.0 && lo < hi)
+    {
+        return Err(VerneError::Usage(format!(
+            "lambda bounds {lo},{hi}: expected 0 < LO < HI"
+        )));
+    }
+    if let Some(p) = plot
+        && !p.extension().is_some_and(|e| e.eq_ignore_ascii_case("svg"))
+    {
+        return Err(VerneError::Usage(format!(
+            "{}: a glider workspace is plotted as SVG; give a file name ending in .svg",
+            p.display()
+        )));
+    }
+    let base = WorkspaceOptions {
+        lambda_bounds,
+        ..WorkspaceOptions::default()
+    };
+    let nodes = match (step, nodes) {
+        (Some(_), Some(_)) => {
+            return Err(VerneError::Usage(
+                "give the grid as a step or as a node count, not both".into(),
+            ));
+        }
+        (Some(s), None) => {
+            if !(s.is_finite() && s > 0.0) {
+                return Err(VerneError::Usage(format!(
+                    "step {s}: expected a length > 0"
+                )));
+            }
+            // A two-node grid spans the window: its step is the window's longer side.
+            let window = sample_workspace(
+                spec,
+                &WorkspaceOptions {
+                    nodes: 2,
+                    ..base.clone()
+                },
+            )
+            .step;
+            let n = (window / s).ceil() + 1.0;
+            if n > WORKSPACE_MAX_NODES as f64 {
+                return Err(VerneError::Usage(format!(
+                    "step {s}: {n} nodes along the {window:.4} window, more than the \
+                     {WORKSPACE_MAX_NODES} allowed; give a larger step"
+                )));
+            }
+            n.max(2.0) as usize
+        }
+        (None, Some(n)) => {
+            if !(2..=WORKSPACE_MAX_NODES).contains(&n) {
+                return Err(VerneError::Usage(format!(
+                    "{n} nodes: expected 2 to {WORKSPACE_MAX_NODES}"
+                )));
+            }
+            n
+        }
+        (None, None) => WORKSPACE_DEFAULT_NODES,
+    };
+    let opts = WorkspaceOptions { nodes, ..base };
+    let grid = sample_workspace(spec, &opts);
+    // S and the largest square: the better of the two orientations of docs/gliders.md.
+    let turned = sample_workspace(
+        spec,
+        &WorkspaceOptions {
+            frame_angle: std::f64::consts::FRAC_PI_4,
+            ..opts.clone()
+        },
+    );
+    let best = |f: fn(&WorkspaceGrid) -> Option<Rectangle>| -> Option<Rectangle> {
+        match (f(&grid), f(&turned)) {
+            (Some(a), Some(b)) => Some(if b.area() > a.area() { b } else { a }),
+            (a, b) => a.or(b),
+        }
+    };
+    let (rect, square) = (best(largest_rectangle), best(largest_square));
+
+    if let Some(out) = output {
+        write_workspace_points(spec, &grid, &opts, out, units)?;
+    }
+    if let Some(p) = plot {
+        write_atomic(p, &workspace_svg(spec, &grid, rect, square))?;
+    }
+
+    let cell = grid.step * grid.step;
+    let count = |f: &dyn Fn(NodeClass) -> bool| grid.class.iter().filter(|&&c| f(c)).count();
+    let reached = count(&|c| !matches!(c, NodeClass::Unreachable | NodeClass::OutOfRange));
+    let admissible = count(&|c| c == NodeClass::Admissible);
+    let mut s = String::new();
+    let bounds = match lambda_bounds {
+        Some([lo, hi]) => format!("{lo:.6} <= lambda_i <= {hi:.6} (eq. (4))"),
+        None => "no amplification bound".into(),
+    };
+    let _ = writeln!(
+        s,
+        "verne workspace: {} (glider), working mode {}, assembly mode {}, {bounds}",
+        spec.name,
+        mode_label(opts.mode),
+        branch_label(opts.assembly)
+    );
+    let _ = writeln!(
+        s,
+        "  grid: {} x {} nodes, step {:.6}",
+        grid.nx, grid.ny, grid.step
+    );
+    let _ = writeln!(
+        s,
+        "  workspace of mode {} within the joint ranges: area {:.6} ({reached} nodes)",
+        mode_label(opts.mode),
+        reached as f64 * cell
+    );
+    let _ = writeln!(
+        s,
+        "  admissible (regular, assembly {}, bounds met): area {:.6} ({admissible} nodes)",
+        branch_label(opts.assembly),
+        admissible as f64 * cell
+    );
+    match grid.seed {
+        Some((i, j)) => {
+            let c = grid.node(i, j);
+            let _ = writeln!(
+                s,
+                "  t-connected region of ({:.6}, {:.6}): area {:.6}",
+                c.x,
+                c.y,
+                grid.region_area()
+            );
+        }
+        None => {
+            let _ = writeln!(
+                s,
+                "  t-connected region: empty (the centre of the joint box is not admissible)"
+            );
+        }
+    }
+    for (name, r) in [("largest rectangle (S)", rect), ("largest square", square)] {
+        if let Some(r) = r {
+            let _ = writeln!(
+                s,
+                "  {name}: {:.6} x {:.6} = {:.6}, sides at {:.0} deg, centre ({:.6}, {:.6})",
+                r.width,
+                r.height,
+                r.area(),
+                r.angle.to_degrees(),
+                r.centre.x,
+                r.centre.y
+            );
+        }
+    }
+    if let Some(out) = output {
+        let _ = writeln!(
+            s,
+            "  wrote {} points to {}",
+            grid.nx * grid.ny,
+            out.display()
+        );
+    }
+    if let Some(p) = plot {
+        let _ = writeln!(s, "  wrote the picture to {}", p.display());
+    }
+    eprint!("{s}");
+    Ok(if grid.seed.is_some() {
+        EXIT_OK
+    } else {
+        EXIT_ROWS_FAILED
+    })
+}
+
+fn write_workspace_points(
+    spec: &GliderSpec,
+    grid: &WorkspaceGrid,
+    opts: &WorkspaceOptions,
+    out: &Path,
+    units: Units,
+) -> Result<(), VerneError> {
+    let mut sink = Sink::create(Some(out))?;
+    let mut rec = ByteRecord::new();
+    for h in WORKSPACE_HEADER {
+        rec.push_field(h.as_bytes());
+    }
+    sink.write(&rec)?;
+    let mut buf = Vec::with_capacity(24);
+    for j in 0..grid.ny {
+        for i in 0..grid.nx {
+            let k = j * grid.nx + i;
+            let p = grid.node(i, j);
+            let rho = inverse_kinematics_in_mode(spec, p, opts.mode);
+            let lambda = rho.and_then(|r| amplification(spec, p, r));
+            let cells = [
+                Cell::Num(p.x),
+                Cell::Num(p.y),
+                rho.map_or(Cell::Empty, |r| Cell::Num(r.x)),
+                rho.map_or(Cell::Empty, |r| Cell::Num(r.y)),
+                lambda.map_or(Cell::Empty, |a| Cell::Num(a.lambda_min)),
+                lambda.map_or(Cell::Empty, |a| Cell::Num(a.lambda_max)),
+                Cell::Str(class_code(grid.class[k])),
+                Cell::Bool(grid.region[k]),
+            ];
+            rec.clear();
+            for c in cells {
+                buf.clear();
+                write_cell(&mut buf, c, units);
+                rec.push_field(&buf);
+            }
+            if let Err(e) = sink.write(&rec) {
+                sink.discard();
+                return Err(e);
+            }
+        }
+    }
+    sink.finish()
+}
+
+/// Writes text to `path` as every output file is written ([`crate::table::write_output`]).
+fn write_atomic(path: &Path, text: &str) -> Result<(), VerneError> {
+    crate::table::write_output(path, text.as_bytes())
+        .map_err(|e| VerneError::io(&path.display().to_string(), e))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::PathBuf;
+    use verne::glider::PAPER_LAMBDA_BOUNDS;
+
+    fn scratch(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("verne-glider-{}-{name}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    #[test]
+    fn workspace_writes_points_plot_and_finds_a_rectangle() {
+        let dir = scratch("ws");
+        let (csv, svg) = (dir.join("points.csv"), dir.join("ws.svg"));
+        let spec = GliderSpec::preset("orthoglide").unwrap();
+        let code = workspace(
+            &spec,
+            None,
+            Some(101),
+            Some(PAPER_LAMBDA_BOUNDS),
+            Some(&csv),
+            Some(&svg),
+            Units::default(),
+        )
+        .unwrap();
+        assert_eq!(code, EXIT_OK);
+        let text = std::fs::read_to_string(&csv).unwrap();
+        let mut lines = text.lines();
+        assert_eq!(lines.next(), Some(WORKSPACE_HEADER.join(",").as_str()));
+        let rows: Vec<&str> = lines.collect();
+        // 101 nodes along the longer side; every node is written.
+        assert!(rows.len() >= 101 * 50, "{} rows", rows.len());
+        assert!(rows.iter().any(|r| r.ends_with(",admissible,true")));
+        assert!(rows.iter().any(|r| r.contains(",unreachable,")));
+        let picture = std::fs::read_to_string(&svg).unwrap();
+        assert!(picture.starts_with("<svg") && picture.trim_end().ends_with("</svg>"));
+        assert!(picture.contains("<polygon"));
+        // No temporary file is left beside the outputs.
+        let names: Vec<_> = std::fs::read_dir(&dir).unwrap().collect();
+        assert_eq!(names.len(), 2);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn workspace_step_sets_the_grid_and_bad_arguments_are_refused() {
+        let spec = GliderSpec::preset("biglide2").unwrap();
+        let ok = workspace(&spec, Some(0.05), None, None, None, None, Units::default());
+        assert_eq!(ok.unwrap(), EXIT_OK);
+        let both = workspace(
+            &spec,
+            Some(0.05),
+            Some(11),
+            None,
+            None,
+            None,
+            Units::default(),
+        );
+        assert!(both.unwrap_err().to_string().contains("not both"));
+        let tiny = workspace(&spec, Some(1e-9), None, None, None, None, Units::default());
+        assert!(tiny.unwrap_err().to_string().contains("larger step"));
+        let png = workspace(
+            &spec,
+            None,
+            Some(11),
+            None,
+            None,
+            Some(Path::new("w.png")),
+            Units::default(),
+        );
+        assert!(png.unwrap_err().to_string().contains(".svg"));
+        let bounds = workspace(
+            &spec,
+            None,
+            Some(11),
+            Some([3.0, 1.0]),
+            None,
+            None,
+            Units::default(),
+        );
+        assert!(bounds.is_err());
+    }
+}
