@@ -8,34 +8,22 @@ use nalgebra::Vector3;
 use verne::parallel_module::equations::ModulePose;
 use verne::parallel_module::ik;
 use verne::spec::Machine;
-use verne::workspace::{self, Of, PAPER_LAMBDA_BOUNDS, PointResult, Workspace, WorkspaceOptions};
+use verne::workspace::{self, Of, PAPER_LAMBDA_BOUNDS, WorkspaceOptions};
 use verne_cli::plot;
-
-fn options(of: Of, tool_length: f64, step: f64) -> WorkspaceOptions {
-    WorkspaceOptions {
-        of,
-        tool_length,
-        step,
-        bounds: None,
-        lambda: PAPER_LAMBDA_BOUNDS,
-    }
-}
-
-fn run(m: &Machine, opts: &WorkspaceOptions) -> (Workspace, Vec<PointResult>) {
-    let mut points = Vec::new();
-    let ws = workspace::compute::<()>(m, opts, &|_| {}, |r| {
-        points.push(*r);
-        Ok(())
-    })
-    .unwrap()
-    .unwrap();
-    (ws, points)
-}
 
 #[test]
 fn pictures_are_written_in_both_formats() {
     let m = Machine::default_verne();
-    let (ws, _) = run(&m, &options(Of::Tool, 50.0, 60.0));
+    let opts = WorkspaceOptions {
+        of: Of::Tool,
+        tool_length: 50.0,
+        step: 60.0,
+        bounds: None,
+        lambda: PAPER_LAMBDA_BOUNDS,
+    };
+    let ws = workspace::compute::<()>(&m, &opts, &|_| {}, |_| Ok(()))
+        .unwrap()
+        .unwrap();
     let dir = std::env::temp_dir().join(format!("verne-ws-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     for name in ["ws.svg", "ws.png"] {

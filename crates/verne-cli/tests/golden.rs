@@ -16,12 +16,11 @@
 use std::fs;
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
 
-const BIN: &str = env!("CARGO_BIN_EXE_verne");
-/// Where the binary runs, so that the cases' relative paths (`data/...`, `tests/...`) resolve.
-const ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
-/// The corpus, relative to [`ROOT`].
+mod common;
+
+/// The corpus, relative to the repository root ([`common::ROOT`]), where the binary runs so that
+/// the cases' relative paths (`data/...`, `tests/...`) resolve.
 const GOLDEN: &str = "tests/golden";
 /// Set to rewrite the expected files.
 const UPDATE_VAR: &str = "VERNE_GOLDEN_UPDATE";
@@ -108,7 +107,7 @@ fn filter(bytes: &[u8], scratch: &str) -> Vec<u8> {
     out.into_bytes()
 }
 
-fn run(root: &Path, case: &Case, scratch: &Path) -> Outcome {
+fn run(case: &Case, scratch: &Path) -> Outcome {
     let _ = fs::remove_dir_all(scratch);
     fs::create_dir_all(scratch).unwrap();
     let scratch_text = scratch.display().to_string();
@@ -117,17 +116,7 @@ fn run(root: &Path, case: &Case, scratch: &Path) -> Outcome {
         .iter()
         .map(|a| a.replace("$OUT", &scratch_text))
         .collect();
-    let mut child = Command::new(BIN)
-        .args(&args)
-        .current_dir(root)
-        // Help text wraps at the terminal's width; no terminal here, and no inherited width.
-        .env_remove("COLUMNS")
-        .env_remove("LINES")
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("binary runs");
+    let mut child = common::command(&args).spawn().expect("binary runs");
     {
         let mut input = child.stdin.take().unwrap();
         if let Some(f) = &case.stdin {
@@ -243,7 +232,7 @@ fn differences(expected: &Outcome, actual: &Outcome) -> Vec<String> {
 
 #[test]
 fn every_case_matches_its_recorded_output() {
-    let root = Path::new(ROOT);
+    let root = Path::new(common::ROOT);
     let update = std::env::var_os(UPDATE_VAR).is_some();
     let cases = cases(root);
     let expected_dir = root.join(GOLDEN).join("expected");
@@ -259,7 +248,7 @@ fn every_case_matches_its_recorded_output() {
                 loop {
                     let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
                     let Some(case) = cases.get(i) else { break };
-                    let actual = run(root, case, &scratch);
+                    let actual = run(case, &scratch);
                     let dir = expected_dir.join(&case.name);
                     if update {
                         write_expected(&dir, &actual);

@@ -66,67 +66,6 @@ impl JointReader {
             index: 0,
         })
     }
-
-    pub fn name(&self) -> &str {
-        self.src.name()
-    }
-
-    pub fn has_id(&self) -> bool {
-        self.id.is_some()
-    }
-
-    /// True when velocities can be checked.
-    pub fn timed(&self) -> bool {
-        self.t.is_some() || self.feed.is_some()
-    }
-
-    pub fn next_item(&mut self) -> Result<Option<Item<Joints>>, VerneError> {
-        if !self.src.read(&mut self.rec)? {
-            return Ok(None);
-        }
-        self.index += 1;
-        let name = self.src.name().to_string();
-        let line = self.rec.position().map(|p| p.line()).unwrap_or(0);
-        let mut v = [0.0; 5];
-        let mut bad = None;
-        for k in 0..5 {
-            let unit = if k < 3 { "mm" } else { "degrees" };
-            match cell(&name, &self.rec, self.cols[k], JOINT_NAMES[k], unit)? {
-                Ok(x) => v[k] = if k < 3 { x } else { x.to_radians() },
-                Err(e) => {
-                    bad.get_or_insert(e);
-                }
-            }
-        }
-        let optional =
-            |i: Option<usize>, col: &str, unit: &str| -> Result<Option<f64>, VerneError> {
-                match i {
-                    None => Ok(None),
-                    Some(i) => Ok(cell(&name, &self.rec, i, col, unit)?.ok()),
-                }
-            };
-        let t = optional(self.t, "t", "s")?;
-        let feed = optional(self.feed, "feed", "mm/min")?.map(|f| f / 60.0);
-        let id = self
-            .id
-            .map(|i| String::from_utf8_lossy(self.rec.get(i).unwrap_or(b"")).into_owned());
-        let value = match bad {
-            Some(e) => Err(e),
-            None => Ok(Joints {
-                rho: Sliders::new(v[0], v[1], v[2]),
-                theta1: v[3],
-                theta2: v[4],
-                t,
-                feed,
-            }),
-        };
-        Ok(Some(Item {
-            index: self.index,
-            line,
-            id,
-            value,
-        }))
-    }
 }
 
 #[allow(clippy::large_enum_variant)] // one per run
@@ -198,16 +137,89 @@ impl PathReader {
             index: 0,
         })
     }
+}
 
-    pub fn name(&self) -> &str {
+impl RowSource for JointReader {
+    type Row = Joints;
+    type Error = VerneError;
+
+    fn name(&self) -> &str {
+        self.src.name()
+    }
+
+    fn has_id(&self) -> bool {
+        self.id.is_some()
+    }
+
+    fn next_item(&mut self) -> Result<Option<Item<Joints>>, VerneError> {
+        if !self.src.read(&mut self.rec)? {
+            return Ok(None);
+        }
+        self.index += 1;
+        let name = self.src.name().to_string();
+        let line = self.rec.position().map(|p| p.line()).unwrap_or(0);
+        let mut v = [0.0; 5];
+        let mut bad = None;
+        for k in 0..5 {
+            let unit = if k < 3 { "mm" } else { "degrees" };
+            match cell(&name, &self.rec, self.cols[k], JOINT_NAMES[k], unit)? {
+                Ok(x) => v[k] = if k < 3 { x } else { x.to_radians() },
+                Err(e) => {
+                    bad.get_or_insert(e);
+                }
+            }
+        }
+        let optional =
+            |i: Option<usize>, col: &str, unit: &str| -> Result<Option<f64>, VerneError> {
+                match i {
+                    None => Ok(None),
+                    Some(i) => Ok(cell(&name, &self.rec, i, col, unit)?.ok()),
+                }
+            };
+        let t = optional(self.t, "t", "s")?;
+        let feed = optional(self.feed, "feed", "mm/min")?.map(|f| f / 60.0);
+        let id = self
+            .id
+            .map(|i| String::from_utf8_lossy(self.rec.get(i).unwrap_or(b"")).into_owned());
+        let value = match bad {
+            Some(e) => Err(e),
+            None => Ok(Joints {
+                rho: Sliders::new(v[0], v[1], v[2]),
+                theta1: v[3],
+                theta2: v[4],
+                t,
+                feed,
+            }),
+        };
+        Ok(Some(Item {
+            index: self.index,
+            line,
+            id,
+            value,
+        }))
+    }
+}
+
+impl JointSource for JointReader {
+    /// True when velocities can be checked.
+    fn timed(&self) -> bool {
+        self.t.is_some() || self.feed.is_some()
+    }
+}
+
+impl RowSource for PathReader {
+    type Row = PathPoint;
+    type Error = VerneError;
+
+    fn name(&self) -> &str {
         &self.name
     }
 
-    pub fn has_id(&self) -> bool {
+    fn has_id(&self) -> bool {
         matches!(&self.kind, PathKind::Csv { id: Some(_), .. })
     }
 
-    pub fn next_item(&mut self) -> Result<Option<Item<PathPoint>>, VerneError> {
+    fn next_item(&mut self) -> Result<Option<Item<PathPoint>>, VerneError> {
         match &mut self.kind {
             PathKind::Apt { reader } => {
                 let row = reader
@@ -294,45 +306,5 @@ impl PathReader {
                 }))
             }
         }
-    }
-}
-
-impl RowSource for JointReader {
-    type Row = Joints;
-    type Error = VerneError;
-
-    fn name(&self) -> &str {
-        JointReader::name(self)
-    }
-
-    fn has_id(&self) -> bool {
-        JointReader::has_id(self)
-    }
-
-    fn next_item(&mut self) -> Result<Option<Item<Joints>>, VerneError> {
-        JointReader::next_item(self)
-    }
-}
-
-impl JointSource for JointReader {
-    fn timed(&self) -> bool {
-        JointReader::timed(self)
-    }
-}
-
-impl RowSource for PathReader {
-    type Row = PathPoint;
-    type Error = VerneError;
-
-    fn name(&self) -> &str {
-        PathReader::name(self)
-    }
-
-    fn has_id(&self) -> bool {
-        PathReader::has_id(self)
-    }
-
-    fn next_item(&mut self) -> Result<Option<Item<PathPoint>>, VerneError> {
-        PathReader::next_item(self)
     }
 }

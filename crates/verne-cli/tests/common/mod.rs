@@ -2,6 +2,7 @@
 // Each test crate uses a different subset.
 #![allow(dead_code)]
 
+use std::ffi::OsStr;
 use std::io::Write;
 use std::process::{Command, Output, Stdio};
 
@@ -10,16 +11,23 @@ pub const BIN: &str = env!("CARGO_BIN_EXE_verne");
 /// The repository root, where the binary runs so that `data/...` and `tests/data/...` resolve.
 pub const ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
 
-/// Runs `verne ARGS` from the repository root, feeding `stdin` (then closing it).
-pub fn run(args: &[&str], stdin: Option<&str>) -> Output {
-    let mut child = Command::new(BIN)
-        .args(args)
+/// `verne ARGS` run from the repository root with stdin, stdout and stderr piped; help text
+/// wraps at no inherited terminal width (`COLUMNS`, `LINES` removed).
+pub fn command<S: AsRef<OsStr>>(args: &[S]) -> Command {
+    let mut c = Command::new(BIN);
+    c.args(args)
         .current_dir(ROOT)
+        .env_remove("COLUMNS")
+        .env_remove("LINES")
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("binary runs");
+        .stderr(Stdio::piped());
+    c
+}
+
+/// Runs `verne ARGS` from the repository root, feeding `stdin` (then closing it).
+pub fn run(args: &[&str], stdin: Option<&str>) -> Output {
+    let mut child = command(args).spawn().expect("binary runs");
     {
         let mut input = child.stdin.take().unwrap();
         if let Some(s) = stdin {
