@@ -68,10 +68,9 @@ pub fn machine_file(data: &[u8]) {
     }
 }
 
-/// An APT CL file, read to the end or to its first error.
+/// A CL file in any dialect, read to the end or to its first error (`verne_cl::fuzz_read`).
 pub fn apt_file(data: &[u8]) {
-    let mut reader = crate::input::apt::AptReader::new(Cursor::new(data));
-    while let Ok(Some(_)) = reader.next_row() {}
+    verne_cl::fuzz_read(data);
 }
 
 /// The command-line value parsers, on any text.

@@ -24,6 +24,9 @@ fn cl_file_converts_and_round_trips_through_fk() {
         [
             "line",
             "kind",
+            "motion",
+            "feed",
+            "tool",
             "x",
             "y",
             "z",

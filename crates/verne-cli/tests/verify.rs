@@ -575,23 +575,24 @@ fn json_summary_and_deterministic_report() {
     assert_eq!(rows, ["701", "2101", "2102"], "{:#?}", a.findings);
 }
 
-/// The APT example path with joints from the library: the rows agree exactly; the rapid
+/// The CL example path with joints from the library: the rows agree exactly; the rapid
 /// approach moves between blocks are long straight moves, reported as jumps or chordal errors.
 #[test]
-fn an_apt_path_is_read_and_its_rows_agree() {
+fn a_cl_path_is_read_and_its_rows_agree() {
     let m = Machine::default_verne();
     let cl = std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../../data/example.cl"
     ))
     .unwrap();
-    let mut reader = verne_cli::input::apt::AptReader::new(cl.as_bytes());
+    let (rows, _) =
+        verne_cl::read_all("example.cl", cl.as_bytes(), &verne_cl::Options::default()).unwrap();
     let mut state = PathState::new(FirstRowChoice::SmallestTheta1);
     let mut joints = Vec::new();
-    while let Some(row) = reader.next_row().unwrap() {
-        let axis = row.axis.unwrap_or(Vector3::new(0.0, 0.0, 1.0));
+    for row in &rows {
+        let axis = ToolOrientation::Axis(Vector3::from(row.axis));
         let r = state
-            .next_row(&m, &row.tip, &ToolOrientation::Axis(axis), m.tool_length)
+            .next_row(&m, &Vector3::from(row.tip), &axis, m.tool_length)
             .unwrap();
         joints.push(Joints {
             rho: [r.rho.x, r.rho.y, r.rho.z],

@@ -79,17 +79,10 @@ pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
             }
         }
     };
-    if let Some(summary) = apt_summary
+    if let Some((summary, name)) = apt_summary
         && let Ok(s) = summary.lock()
-        && !s.skipped.is_empty()
     {
-        let skipped: Vec<String> = s.skipped.iter().map(|(k, n)| format!("{k} x{n}")).collect();
-        eprintln!(
-            "verne ik: CL file: {} GOTO and {} FROM rows; records skipped: {}",
-            s.goto_rows,
-            s.from_rows,
-            skipped.join(", ")
-        );
+        crate::input::cl::report_summary("ik", &name, &s);
     }
     Ok(code)
 }
@@ -98,28 +91,18 @@ fn is_apt(input: Option<&Path>, format: Option<InputFormat>) -> bool {
     match format {
         Some(f) => f == InputFormat::Apt,
         None => input
-            .and_then(|p| p.extension())
-            .and_then(|e| e.to_str())
-            .is_some_and(|e| e.eq_ignore_ascii_case("cl") || e.eq_ignore_ascii_case("apt")),
+            .and_then(|p| p.to_str())
+            .is_some_and(verne_cl::has_cl_extension),
     }
 }
 
-type SharedAptSummary = std::sync::Arc<std::sync::Mutex<crate::input::apt::AptSummary>>;
+type SharedClSummary = std::sync::Arc<std::sync::Mutex<verne_cl::Summary>>;
 
-/// A CL file as a CSV source with columns line,kind,x,y,z,i,j,k.
-fn apt_source(input: Option<&Path>) -> Result<(CsvSource, SharedAptSummary), VerneError> {
-    let (reader, name): (Box<dyn std::io::BufRead + Send>, String) = match input {
-        Some(p) if p.as_os_str() != "-" => {
-            let name = p.display().to_string();
-            let f = std::fs::File::open(p).map_err(|e| VerneError::io(&name, e))?;
-            (Box::new(std::io::BufReader::new(f)), name)
-        }
-        _ => (
-            Box::new(std::io::BufReader::new(std::io::stdin())),
-            "<stdin>".to_string(),
-        ),
-    };
-    let adapter = crate::input::apt::AptAsCsv::new(reader);
+/// A CL file as a CSV source with columns line,kind,motion,feed,tool,x,y,z,i,j,k.
+fn apt_source(input: Option<&Path>) -> Result<(CsvSource, (SharedClSummary, String)), VerneError> {
+    let (reader, name) = crate::input::cl::open_cl(input, verne_cl::Options::default())?;
+    let adapter = crate::input::cl::ClAsCsv::new(reader);
     let summary = adapter.summary();
-    Ok((CsvSource::from_reader(Box::new(adapter), &name)?, summary))
+    let source = CsvSource::from_reader(Box::new(adapter), &name)?;
+    Ok((source, (summary, name)))
 }

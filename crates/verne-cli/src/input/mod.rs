@@ -1,5 +1,6 @@
-//! Readers of the inputs that are not plain row tables: APT CL files ([`apt`]) and the two inputs
-//! of `verne verify` ([`verify_files`]). CSV reading itself is in [`crate::table`].
+//! Readers of the inputs that are not plain row tables: CL files ([`cl`], over the `verne-cl`
+//! crate) and the two inputs of `verne verify` ([`verify_files`]). CSV reading itself is in
+//! [`crate::table`].
 
-pub mod apt;
+pub mod cl;
 pub mod verify_files;

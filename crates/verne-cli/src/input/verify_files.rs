@@ -2,7 +2,6 @@
 //! or APT CL), read row by row for the core's checks ([`verne::verify::RowSource`]), with
 //! file/line/column errors for malformed cells.
 
-use std::io::BufRead;
 use std::path::Path;
 
 use csv::ByteRecord;
@@ -13,7 +12,7 @@ use verne::parallel_module::equations::Sliders;
 use verne::verify::{Item, JOINT_NAMES, JointSource, Joints, PathPoint, RowSource};
 
 use crate::error::VerneError;
-use crate::input::apt::{AptReader, MotionKind};
+use crate::input::cl::{ClReader, cl_error, open_cl};
 use crate::table::{CellError, CsvSource, parse_number};
 
 /// Reads a cell as a number; a non-number is fatal (file, line, column), an empty or non-finite
@@ -79,8 +78,8 @@ enum PathKind {
         id: Option<usize>,
         rec: ByteRecord,
     },
-    Apt {
-        reader: Box<AptReader<Box<dyn BufRead + Send>>>,
+    Cl {
+        reader: Box<ClReader>,
     },
 }
 
@@ -93,19 +92,14 @@ pub struct PathReader {
 }
 
 impl PathReader {
-    /// Opens a path file: `.cl`, `.apt`, `.cls` (any case) as APT, anything else as CSV.
+    /// Opens a path file: a CL file by its name (`verne_cl::has_cl_extension`: .cl, .cls, .apt,
+    /// .ncl, .aptsource, ...) in any dialect of `docs/cl-dialects.md`, anything else as CSV.
     pub fn open(path: &Path) -> Result<PathReader, VerneError> {
-        let ext = path
-            .extension()
-            .map(|e| e.to_string_lossy().to_ascii_lowercase())
-            .unwrap_or_default();
-        let name = path.display().to_string();
-        if matches!(ext.as_str(), "cl" | "apt" | "cls") {
-            let f = std::fs::File::open(path).map_err(|e| VerneError::io(&name, e))?;
-            let r: Box<dyn BufRead + Send> = Box::new(std::io::BufReader::new(f));
+        if verne_cl::has_cl_extension(&path.to_string_lossy()) {
+            let (reader, name) = open_cl(Some(path), verne_cl::Options::default())?;
             return Ok(PathReader {
-                kind: PathKind::Apt {
-                    reader: Box::new(AptReader::new(r)),
+                kind: PathKind::Cl {
+                    reader: Box::new(reader),
                 },
                 name,
                 index: 0,
@@ -221,29 +215,22 @@ impl RowSource for PathReader {
 
     fn next_item(&mut self) -> Result<Option<Item<PathPoint>>, VerneError> {
         match &mut self.kind {
-            PathKind::Apt { reader } => {
-                let row = reader
-                    .next_row()
-                    .map_err(|e| VerneError::input(&self.name, None, None, e.to_string()))?;
-                let Some(row) = row else { return Ok(None) };
+            PathKind::Cl { reader } => {
+                let row = match reader.next() {
+                    None => return Ok(None),
+                    Some(r) => r.map_err(|e| cl_error(&self.name, &e))?,
+                };
                 self.index += 1;
-                let axis = row.axis.unwrap_or(Vector3::new(0.0, 0.0, 1.0));
+                let axis = Vector3::from(row.axis);
                 let value = unit_axis(&axis)
-                    .map(|axis| PathPoint { tip: row.tip, axis })
-                    .map_err(|e| {
-                        format!(
-                            "{} at line {}: {e}",
-                            if row.kind == MotionKind::From {
-                                "FROM"
-                            } else {
-                                "GOTO"
-                            },
-                            row.line
-                        )
-                    });
+                    .map(|axis| PathPoint {
+                        tip: Vector3::from(row.tip),
+                        axis,
+                    })
+                    .map_err(|e| format!("{} at line {}: {e}", row.kind, row.line));
                 Ok(Some(Item {
                     index: self.index,
-                    line: row.line as u64,
+                    line: row.line,
                     id: None,
                     value,
                 }))
