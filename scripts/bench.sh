@@ -90,10 +90,20 @@ gen_tool_path() { # rows file
     }' > "$2"
 }
 
+# The same tool poses as a CL file (UNITS/MM, MULTAX/ON, one 6-value GOTO per pose): the CL
+# reader against the CSV reader on identical poses.
+gen_tool_cl() { # tool-csv cl-file
+    { echo "UNITS/MM"; echo "MULTAX/ON"; tail -n +2 "$1" | sed 's|^|GOTO/|'; echo "FINI"; } > "$2"
+}
+
 PATH_CSV="$WORK/path_$ROWS.csv"
 TOOL_ROWS=$((ROWS / 10))
 TOOL_CSV="$WORK/tool_path_$TOOL_ROWS.csv"
 [ -s "$TOOL_CSV" ] || { log "generating $TOOL_CSV"; gen_tool_path "$TOOL_ROWS" "$TOOL_CSV"; }
+CL_CSV="$WORK/tool_path_$ROWS.csv"
+CL_FILE="$WORK/tool_path_$ROWS.cl"
+[ -s "$CL_CSV" ] || { log "generating $CL_CSV"; gen_tool_path "$ROWS" "$CL_CSV"; }
+[ -s "$CL_FILE" ] || { log "generating $CL_FILE"; gen_tool_cl "$CL_CSV" "$CL_FILE"; }
 JOINTS_CSV="$WORK/joints_$ROWS.csv"
 [ -s "$PATH_CSV" ] || { log "generating $PATH_CSV"; gen_path "$ROWS" "$PATH_CSV"; }
 log "verne ik -> $JOINTS_CSV (the fk input)"
@@ -145,6 +155,8 @@ run_case fk1 env RAYON_NUM_THREADS=1 "$VERNE" fk "$JOINTS_CSV" -o "$OUT"
 run_case floor_fk "$FLOOR" fk "$JOINTS_CSV" -o "$OUT"
 run_case tool "$VERNE" ik "$TOOL_CSV" -o "$OUT"
 run_case tool1 env RAYON_NUM_THREADS=1 "$VERNE" ik "$TOOL_CSV" -o "$OUT"
+run_case cl_csv "$VERNE" ik "$CL_CSV" -o "$OUT"
+run_case cl "$VERNE" ik "$CL_FILE" -o "$OUT"
 rm -f "$OUT"
 
 BIG_IK=""; BIG_FK=""
@@ -208,6 +220,16 @@ REPORT="$WORK/report.md"
             "$(rate "${T[$k]}" "$TOOL_ROWS")" \
             "$(awk -v c="$(cpu "${U[$k]}" "${S[$k]}")" -v n="$TOOL_ROWS" 'BEGIN { printf "%.1f", c / n * 1e6 }')" "${R[$k]}"
     done
+    echo
+    echo "CL input, $ROWS tool poses of the same spiral as a CL file (\`$CL_FILE\`, 6-value GOTOs) and as CSV (target: CL no slower than 1.2x CSV, memory under 32 MB):"
+    echo
+    echo "| command | wall s | CPU s | wall / CSV | peak RSS MiB |"
+    echo "|---|---:|---:|---:|---:|"
+    for k in cl_csv cl; do
+        label="\`verne ik\` on the CSV"; [ "$k" = cl ] && label="\`verne ik\` on the CL file"
+        printf '| %s | %.3f | %s | %s | %s |\n' "$label" "${T[$k]}" "$(cpu "${U[$k]}" "${S[$k]}")" \
+            "$(ratio "${T[$k]}" "${T[cl_csv]}")" "${R[$k]}"
+    done
     if [ -n "$BIG_IK" ]; then
         echo
         echo "Memory check, $BIG_ROWS rows: peak RSS \`verne ik\` $BIG_IK MiB, \`verne fk\` $BIG_FK MiB (target < 32 MB)."
@@ -226,6 +248,8 @@ REPORT="$WORK/report.md"
     echo "$FLOOR fk $JOINTS_CSV -o $OUT"
     echo "$VERNE ik $TOOL_CSV -o $OUT"
     echo "RAYON_NUM_THREADS=1 $VERNE ik $TOOL_CSV -o $OUT"
+    echo "$VERNE ik $CL_CSV -o $OUT"
+    echo "$VERNE ik $CL_FILE -o $OUT"
     [ -n "$BIG_IK" ] && echo "/usr/bin/time -v $VERNE ik $WORK/path_$BIG_ROWS.csv -o $WORK/joints_$BIG_ROWS.csv"
     [ -n "$BIG_IK" ] && echo "/usr/bin/time -v $VERNE fk $WORK/joints_$BIG_ROWS.csv > /dev/null"
     [ -n "$KERNEL_TABLE" ] && echo "VERNE_BENCH_SUMMARY=$WORK/kernels.md cargo bench -p verne-cli --bench kernels"

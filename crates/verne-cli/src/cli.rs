@@ -92,10 +92,12 @@ pub struct CommonArgs {
 #[derive(Debug, Args)]
 pub struct IkArgs {
     /// Input: a CSV of tool poses (x,y,z with i,j,k or phi1,phi2; workpiece frame), a CSV of
-    /// platform points (xp,yp,zp), or an APT CL file (.cl/.apt); absent or `-` reads stdin.
+    /// platform points (xp,yp,zp), or a CL file (APT, NX CLSF, Creo, CATIA, SolidWorks CAM);
+    /// absent or `-` reads stdin.
     #[arg(value_name = "INPUT")]
     pub input: Option<PathBuf>,
-    /// How to read INPUT (default: `apt` for a .cl or .apt file, else `csv`).
+    /// How to read INPUT (default: `apt` for a CL file, known by its extension or its first
+    /// record, else `csv`).
     #[arg(long, value_enum, value_name = "FORMAT")]
     pub input_format: Option<InputFormat>,
     /// One platform point XP,YP,ZP instead of an input file (repeatable). Use
@@ -122,6 +124,8 @@ pub struct IkArgs {
     #[arg(long)]
     pub all: bool,
     #[command(flatten)]
+    pub part: PartArgs,
+    #[command(flatten)]
     pub common: CommonArgs,
 }
 
@@ -147,6 +151,10 @@ pub struct FkArgs {
     /// Every real assembly mode, one row each, instead of the machine's working mode.
     #[arg(long)]
     pub all: bool,
+    /// Where the part sits on the table: X,Y,Z (mm) taken off every tool tip written (the
+    /// inverse of `verne ik --offset`).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_triple, allow_hyphen_values = true)]
+    pub offset: Option<[f64; 3]>,
     #[command(flatten)]
     pub common: CommonArgs,
 }
@@ -181,6 +189,51 @@ pub enum MachineCommand {
 }
 
 pub use crate::arg_values::*;
+
+/// How a toolpath is read and where the part sits (`verne ik`, `verne verify --path`).
+#[derive(Debug, Clone, Args)]
+pub struct PartArgs {
+    /// Units of a CL file. Default: what the file says (UNITS, else its feed words IPM/MMPM,
+    /// else mm with a warning); given, a UNITS record that says otherwise is an error.
+    #[arg(long, value_enum, value_name = "UNITS")]
+    pub units: Option<ClUnits>,
+    /// Chordal tolerance (mm) of the points interpolated on a CL file's CIRCLE arcs.
+    #[arg(long = "chord-tol", value_name = "MM", value_parser = crate::arg_values::parse_positive, default_value_t = verne_cl::DEFAULT_CHORD_TOL_MM)]
+    pub chord_tol: f64,
+    /// Where the part sits on the table: X,Y,Z (mm) added to every tool tip read (CAM's part
+    /// frame -> the machine's workpiece frame); `verne fk --offset` takes it off again.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_triple, allow_hyphen_values = true)]
+    pub offset: Option<[f64; 3]>,
+}
+
+impl PartArgs {
+    /// The CL reader's options.
+    pub fn cl_options(&self) -> verne_cl::Options {
+        verne_cl::Options {
+            chord_tol_mm: self.chord_tol,
+            units: self.units.map(|u| match u {
+                ClUnits::Mm => verne_cl::Units::Mm,
+                ClUnits::In => verne_cl::Units::Inch,
+            }),
+            ..verne_cl::Options::default()
+        }
+    }
+
+    /// The part's offset (zero when not given).
+    pub fn offset(&self) -> nalgebra::Vector3<f64> {
+        self.offset
+            .map_or(nalgebra::Vector3::zeros(), nalgebra::Vector3::from)
+    }
+}
+
+/// Units of a CL file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ClUnits {
+    /// Millimetres.
+    Mm,
+    /// Inches (every length and feed times 25.4).
+    In,
+}
 
 /// How `verne ik` reads its input.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -304,10 +357,12 @@ pub struct VerifyArgs {
     /// feed (mm/min).
     #[arg(long, value_name = "POST.csv")]
     pub joints: PathBuf,
-    /// Intended path: CSV with x,y,z and i,j,k or phi1,phi2 (degrees), optional id; or an APT CL
-    /// file (.cl, .apt, .cls).
+    /// Intended path: CSV with x,y,z and i,j,k or phi1,phi2 (degrees), optional id; or a CL
+    /// file (APT, NX CLSF, Creo, CATIA, SolidWorks CAM).
     #[arg(long, value_name = "INTENDED.csv|cl")]
     pub path: PathBuf,
+    #[command(flatten)]
+    pub part: PartArgs,
     /// Machine file (TOML, or CSV with a `key,value` header); its [verify] table sets thresholds.
     /// Default: the embedded VERNE machine.
     #[arg(short = 'm', long = "machine", value_name = "FILE")]

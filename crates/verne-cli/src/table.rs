@@ -19,6 +19,9 @@ pub struct CsvSource {
     headers: ByteRecord,
     /// The record as read, before its fields are trimmed into the caller's record.
     raw: ByteRecord,
+    /// A column that holds each row's line in the file the rows come from (a CL file read as
+    /// CSV): messages then name that line rather than the line of the CSV text.
+    line_column: Option<usize>,
 }
 
 impl CsvSource {
@@ -71,6 +74,7 @@ impl CsvSource {
             name: name.to_string(),
             headers: headers_clean,
             raw: ByteRecord::new(),
+            line_column: None,
         };
         src.check_duplicate_headers()?;
         Ok(src)
@@ -95,6 +99,17 @@ impl CsvSource {
 
     pub fn name(&self) -> &str {
         &self.name
+    }
+
+    /// Takes each row's line in messages from the column `name` (see [`CsvSource::line_of`]).
+    pub fn with_line_column(mut self, name: &str) -> CsvSource {
+        self.line_column = self.column(name);
+        self
+    }
+
+    /// The column that holds each row's line in its original file, if any.
+    pub fn line_column(&self) -> Option<usize> {
+        self.line_column
     }
 
     pub fn headers(&self) -> &ByteRecord {
@@ -473,6 +488,18 @@ pub fn format_number(out: &mut Vec<u8>, v: f64, decimals: Option<usize>) {
         Some(d) => {
             let _ = write!(out, "{v:.d$}");
         }
+    }
+}
+
+/// The line a record comes from: the value of `line_column` when the rows come from another
+/// file (a CL file read as CSV), else the record's line in the CSV text.
+pub fn line_of(record: &ByteRecord, line_column: Option<usize>) -> Option<u64> {
+    match line_column {
+        Some(c) => record
+            .get(c)
+            .and_then(|f| std::str::from_utf8(f).ok())
+            .and_then(|f| f.parse().ok()),
+        None => record.position().map(|p| p.line()),
     }
 }
 

@@ -44,9 +44,16 @@ fn cl_file_converts_and_round_trips_through_fk() {
         ]
     );
     assert_eq!(rows.len(), 181, "180 GOTO rows and the FROM row");
-    let fk = run(&["fk"], Some(&ik_text));
+    assert_fk_gives_back(&ik_text, &["fk"]);
+}
+
+/// `verne fk` (with `fk_args`) on the joint table `ik_text` gives back its x,y,z and unit axis.
+fn assert_fk_gives_back(ik_text: &str, fk_args: &[&str]) {
+    let (h, rows) = table(ik_text);
+    let fk = run(fk_args, Some(ik_text));
     assert_eq!(fk.status.code(), Some(0));
     let (h2, back) = table(&String::from_utf8(fk.stdout).unwrap());
+    assert_eq!(rows.len(), back.len());
     for (a, b) in rows.iter().zip(&back) {
         for c in ["x", "y", "z"] {
             let d = (num(&a[col(&h, c)]) - num(&b[col(&h2, c)])).abs();
@@ -60,6 +67,45 @@ fn cl_file_converts_and_round_trips_through_fk() {
             assert!(d < AXIS_TOL, "line {}: axis component {k} off by {d}", a[0]);
         }
     }
+}
+
+/// `--offset` places the part on the table: the joints are exactly those of the same poses
+/// moved by the offset (given as CSV, without the flag), and `verne fk --offset` gives back the
+/// file's own tips.
+#[test]
+fn offset_places_the_part_and_fk_takes_it_off() {
+    let offset = [-30.0, 20.0, 50.0];
+    let flag = "--offset=-30,20,50";
+    let ik = run(&["ik", "data/example.cl", flag], None);
+    assert_eq!(ik.status.code(), Some(0));
+    let ik_text = String::from_utf8(ik.stdout).unwrap();
+    let (h, rows) = table(&ik_text);
+    let mut moved = String::from("x,y,z,i,j,k\n");
+    for r in &rows {
+        let v: Vec<f64> = ["x", "y", "z", "i", "j", "k"]
+            .iter()
+            .map(|c| num(&r[col(&h, c)]))
+            .collect();
+        moved.push_str(&format!(
+            "{},{},{},{},{},{}\n",
+            v[0] + offset[0],
+            v[1] + offset[1],
+            v[2] + offset[2],
+            v[3],
+            v[4],
+            v[5]
+        ));
+    }
+    let plain = run(&["ik"], Some(&moved));
+    assert_eq!(plain.status.code(), Some(0));
+    let (h2, rows2) = table(&String::from_utf8(plain.stdout).unwrap());
+    for (a, b) in rows.iter().zip(&rows2) {
+        for c in ["rho1", "rho2", "rho3", "theta1", "theta2"] {
+            let d = (num(&a[col(&h, c)]) - num(&b[col(&h2, c)])).abs();
+            assert!(d < 1e-9, "line {}: {c} differs by {d}", a[0]);
+        }
+    }
+    assert_fk_gives_back(&ik_text, &["fk", flag]);
 }
 
 #[test]

@@ -575,8 +575,9 @@ fn json_summary_and_deterministic_report() {
     assert_eq!(rows, ["701", "2101", "2102"], "{:#?}", a.findings);
 }
 
-/// The CL example path with joints from the library: the rows agree exactly; the rapid
-/// approach moves between blocks are long straight moves, reported as jumps or chordal errors.
+/// The CL example path with joints from the library: the rows agree exactly; rapid moves are
+/// exempt from the jump and chordal checks (the long feed plunges and the 5-degree contour
+/// steps are not: see docs/verify.md), and the path's feeds time the segments.
 #[test]
 fn a_cl_path_is_read_and_its_rows_agree() {
     let m = Machine::default_verne();
@@ -612,6 +613,14 @@ fn a_cl_path_is_read_and_its_rows_agree() {
         "{}",
         run.stderr
     );
+    assert!(!run.stderr.contains("no t or feed"), "{}", run.stderr);
+    let rapid_rows: Vec<String> = rows
+        .iter()
+        .enumerate()
+        .filter(|(_, r)| r.motion == verne_cl::Motion::Rapid)
+        .map(|(k, _)| (k + 1).to_string())
+        .collect();
+    assert_eq!(rapid_rows.len(), 7, "FROM and six RAPIDs");
     for f in &run.findings {
         assert!(
             ![
@@ -625,7 +634,56 @@ fn a_cl_path_is_read_and_its_rows_agree() {
             .contains(&f.check.as_str()),
             "{f:?}"
         );
+        if ["joint_jump", "chord_error"].contains(&f.check.as_str()) {
+            assert!(!rapid_rows.contains(&f.row), "{f:?}");
+        }
     }
+}
+
+/// A CL path's feed times the segments when the joint table has none: a 10 mm move at
+/// 1,000,000 mm/min is a velocity finding; the same move as a rapid is not checked; a long rapid
+/// is not a jump, a long feed move is.
+#[test]
+fn a_cl_path_feed_times_segments_and_rapids_are_exempt() {
+    let m = Machine::default_verne();
+    let cl = "UNITS/MM\nMULTAX/ON\nFEDRAT/MMPM,600\nGOTO/0,0,50,0,0,1\nRAPID\nGOTO/60,-40,120,0,0,1\n\
+              FEDRAT/MMPM,1000000\nGOTO/60,-40,110,0,0,1\nRAPID\nGOTO/60,-40,100,0,0,1\n\
+              FEDRAT/MMPM,600\nGOTO/0,0,50,0,0,1\n";
+    let (rows, _) =
+        verne_cl::read_all("feeds.cl", cl.as_bytes(), &verne_cl::Options::default()).unwrap();
+    let mut state = PathState::new(FirstRowChoice::SmallestTheta1);
+    let joints: Vec<Joints> = rows
+        .iter()
+        .map(|row| {
+            let axis = ToolOrientation::Axis(Vector3::from(row.axis));
+            let r = state
+                .next_row(&m, &Vector3::from(row.tip), &axis, m.tool_length)
+                .unwrap();
+            Joints {
+                rho: [r.rho.x, r.rho.y, r.rho.z],
+                theta1: r.theta1,
+                theta2: r.theta2,
+                t: 0.0,
+            }
+        })
+        .collect();
+    let jp = temp("feeds-joints.csv", &joints_csv(&joints, false));
+    let pp = temp("feeds.cl", cl);
+    let run = verify_files("feeds", &jp, &pp, &[]);
+    let found: Vec<(&str, &str)> = run
+        .findings
+        .iter()
+        .map(|f| (f.row.as_str(), f.check.as_str()))
+        .collect();
+    // Row 2: a long rapid (no jump, no chord, no speed); row 3: 10 mm at 16,667 mm/s; row 4:
+    // the same 10 mm as a rapid; row 5: back to the start at a feed, a jump.
+    assert!(found.contains(&("3", "velocity")), "{found:?}");
+    assert!(found.contains(&("5", "joint_jump")), "{found:?}");
+    assert!(
+        found.iter().all(|(r, _)| *r != "2" && *r != "4"),
+        "{found:?}"
+    );
+    assert_eq!(run.code, 1);
 }
 
 /// A postprocessor that always takes orientation solution 1 (phi1 > 0): where the tool axis

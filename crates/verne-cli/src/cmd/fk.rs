@@ -35,21 +35,31 @@ pub fn run(args: &FkArgs) -> Result<u8, VerneError> {
     let table = source.column("theta1").is_some() || source.column("theta2").is_some();
     if table {
         let tool_length = args.tool_length.unwrap_or(machine.tool_length);
+        let offset = args
+            .offset
+            .map_or(nalgebra::Vector3::zeros(), nalgebra::Vector3::from);
         let output = args.output.as_ref();
         if args.all {
             let mut job = MachineFkAll {
                 machine,
                 tool_length,
+                offset,
             };
             run_rows("fk", &mut job, source, output, u)
         } else {
             let mut job = MachineFkWorking {
                 machine,
                 tool_length,
+                offset,
             };
             run_rows("fk", &mut job, source, output, u)
         }
     } else {
+        if args.offset.is_some() {
+            return Err(VerneError::Usage(
+                "--offset places tool poses: slider rows (rho1,rho2,rho3 without theta1,theta2) give platform points in the machine's frame".into(),
+            ));
+        }
         let output = args.output.as_ref();
         if args.all {
             run_rows("fk", &mut ModuleFkAll { machine }, source, output, u)

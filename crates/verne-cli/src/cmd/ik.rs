@@ -1,7 +1,5 @@
 //! `verne ik`: tool poses (workpiece frame) -> machine joints, or platform points -> joints of
-//! the parallel module (IFToMM 2007, section V), from CSV or an APT CL file.
-
-use std::path::Path;
+//! the parallel module (IFToMM 2007, section V), from CSV or a CL file.
 
 use crate::engine::machine_rows::{MachineIk, OrientationColumns};
 use crate::engine::module_rows::{ModuleIkAll, ModuleIkWorking};
@@ -11,6 +9,7 @@ use verne::machine::FirstRowChoice;
 
 use super::{inline_source, load_machine, run_rows, units};
 use crate::cli::{IkArgs, InputFormat, OutputFormat, Prefer};
+use crate::input::cl::{ClAsCsv, PathInput, open_path_input, report_summary};
 
 pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
     if let Some(spec) = super::glider::load(args.common.machine.as_deref())? {
@@ -26,7 +25,7 @@ pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
         ));
     }
     let tool_length = args.tool_length.unwrap_or(machine.tool_length);
-    let mut apt_summary = None;
+    let mut cl_summary = None;
     let source = if !args.pose.is_empty() {
         inline_source(
             "xp,yp,zp",
@@ -37,13 +36,18 @@ pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
             "x,y,z,i,j,k",
             &args.tool.iter().map(|p| p.to_vec()).collect::<Vec<_>>(),
         )?
-    } else if is_apt(args.input.as_deref(), args.input_format) {
-        let (src, summary) = apt_source(args.input.as_deref())?;
-        apt_summary = Some(summary);
-        src
     } else {
-        CsvSource::open(args.input.as_deref())?
+        let force = args.input_format.map(|f| f == InputFormat::Apt);
+        match open_path_input(args.input.as_deref(), force, args.part.cl_options())? {
+            PathInput::Csv(src) => src,
+            PathInput::Cl(reader, name) => {
+                let adapter = ClAsCsv::new(*reader);
+                cl_summary = Some((adapter.summary(), name.clone()));
+                CsvSource::from_reader(Box::new(adapter), &name)?.with_line_column("line")
+            }
+        }
     };
+    let offset = args.part.offset();
     let has = |c: &str| source.column(c).is_some();
     let tool_columns = ["x", "y", "z"].iter().all(|c| has(c));
     let platform_columns = ["xp", "yp", "zp"].iter().all(|c| has(c));
@@ -65,9 +69,15 @@ pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
                 Prefer::Orientation2 => FirstRowChoice::Orientation2,
             };
             let mut job = MachineIk::new(machine, tool_length, orientation, args.all, first);
+            job.offset = offset;
             run_rows("ik", &mut job, source, args.output.as_ref(), u)?
         }
         (false, _) => {
+            if args.part.offset.is_some() {
+                return Err(VerneError::Usage(
+                    "--offset places tool poses (x,y,z): platform points (xp,yp,zp) are already in the machine's frame".into(),
+                ));
+            }
             if u.halstreamer {
                 return Err(VerneError::Usage("--format halstreamer writes machine joints: give tool poses (x,y,z with i,j,k or phi1,phi2), not platform points".into()));
             }
@@ -79,30 +89,10 @@ pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
             }
         }
     };
-    if let Some((summary, name)) = apt_summary
+    if let Some((summary, name)) = cl_summary
         && let Ok(s) = summary.lock()
     {
-        crate::input::cl::report_summary("ik", &name, &s);
+        report_summary("ik", &name, &s, tool_length);
     }
     Ok(code)
-}
-
-fn is_apt(input: Option<&Path>, format: Option<InputFormat>) -> bool {
-    match format {
-        Some(f) => f == InputFormat::Apt,
-        None => input
-            .and_then(|p| p.to_str())
-            .is_some_and(verne_cl::has_cl_extension),
-    }
-}
-
-type SharedClSummary = std::sync::Arc<std::sync::Mutex<verne_cl::Summary>>;
-
-/// A CL file as a CSV source with columns line,kind,motion,feed,tool,x,y,z,i,j,k.
-fn apt_source(input: Option<&Path>) -> Result<(CsvSource, (SharedClSummary, String)), VerneError> {
-    let (reader, name) = crate::input::cl::open_cl(input, verne_cl::Options::default())?;
-    let adapter = crate::input::cl::ClAsCsv::new(reader);
-    let summary = adapter.summary();
-    let source = CsvSource::from_reader(Box::new(adapter), &name)?;
-    Ok((source, (summary, name)))
 }

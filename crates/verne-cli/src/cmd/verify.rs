@@ -32,7 +32,7 @@ pub fn run(args: &VerifyArgs) -> Result<u8, VerneError> {
         tool_length: args.tool_length.unwrap_or(machine.tool_length),
     };
     let mut joints = JointReader::new(CsvSource::open(Some(&args.joints))?)?;
-    let mut path = PathReader::open(&args.path)?;
+    let mut path = PathReader::open(&args.path, args.part.cl_options(), args.part.offset())?;
     let mut sink = match &args.report {
         Some(p) => {
             let mut s = Sink::create(Some(p))?;
@@ -68,6 +68,9 @@ pub fn run(args: &VerifyArgs) -> Result<u8, VerneError> {
     };
     if let Some(s) = sink {
         s.finish()?;
+    }
+    if let Some((name, s)) = path.cl_summary() {
+        crate::input::cl::report_summary("verify", name, s, opt.tool_length);
     }
     eprint!(
         "verne verify: {} against {}: {}",

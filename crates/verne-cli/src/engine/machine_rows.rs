@@ -53,6 +53,8 @@ pub struct MachineIk {
     pub orientation: OrientationColumns,
     pub all: bool,
     pub state: PathState,
+    /// Where the part sits on the table (mm, `--offset`): added to every tip read.
+    pub offset: Vector3<f64>,
 }
 
 impl MachineIk {
@@ -69,6 +71,7 @@ impl MachineIk {
             orientation,
             all,
             state: PathState::new(first),
+            offset: Vector3::zeros(),
         }
     }
 }
@@ -154,7 +157,7 @@ impl RowJob for MachineIk {
     }
 
     fn solve(&self, inputs: &[f64], solved: &mut SolvedToolPose) {
-        let tip = Vector3::new(inputs[0], inputs[1], inputs[2]);
+        let tip = Vector3::new(inputs[0], inputs[1], inputs[2]) + self.offset;
         let orientation = self.orientation_of(inputs);
         solved.tip = tip;
         solved.orientation = Some(orientation);
@@ -278,12 +281,16 @@ fn bad_row(out: &mut RowWriter<'_>, e: &PathError, all: bool) -> Result<RowOutco
 pub struct MachineFkAll {
     pub machine: Machine,
     pub tool_length: f64,
+    /// Where the part sits on the table (mm, `--offset`): taken off every tip written.
+    pub offset: Vector3<f64>,
 }
 
 /// Machine FK, the working assembly mode of each row (`verne fk` on machine joints).
 pub struct MachineFkWorking {
     pub machine: Machine,
     pub tool_length: f64,
+    /// Where the part sits on the table (mm, `--offset`): taken off every tip written.
+    pub offset: Vector3<f64>,
 }
 
 const FK_INPUTS: &[(&str, bool)] = &[
@@ -298,10 +305,19 @@ const FK_OUT_ALL: &[&str] = &[
     "branch", "x", "y", "z", "i", "j", "k", "phi1", "phi2", "s1", "s2", "s3", "working", "status",
 ];
 
-/// Every assembly mode of a row of machine joints.
-fn machine_fk_row(m: &Machine, tool_length: f64, inputs: &[f64]) -> MachineFkModes {
+/// Every assembly mode of a row of machine joints, tips in the part's frame (`offset` off).
+fn machine_fk_row(
+    m: &Machine,
+    tool_length: f64,
+    offset: &Vector3<f64>,
+    inputs: &[f64],
+) -> MachineFkModes {
     let rho = Sliders::new(inputs[0], inputs[1], inputs[2]);
-    machine_fk(m, &rho, inputs[3], inputs[4], tool_length)
+    let mut modes = machine_fk(m, &rho, inputs[3], inputs[4], tool_length);
+    for mode in modes.iter_mut() {
+        mode.tool.tip -= offset;
+    }
+    modes
 }
 
 /// The machine's mode: the feasible one (the smallest |alpha| if several are).
@@ -339,7 +355,7 @@ impl RowJob for MachineFkAll {
     }
 
     fn solve(&self, inputs: &[f64], solved: &mut MachineFkModes) {
-        *solved = machine_fk_row(&self.machine, self.tool_length, inputs);
+        *solved = machine_fk_row(&self.machine, self.tool_length, &self.offset, inputs);
     }
 
     fn emit(
@@ -363,7 +379,7 @@ impl RowJob for MachineFkWorking {
     }
 
     fn solve(&self, inputs: &[f64], solved: &mut Working<MachineFkMode>) {
-        let modes = machine_fk_row(&self.machine, self.tool_length, inputs);
+        let modes = machine_fk_row(&self.machine, self.tool_length, &self.offset, inputs);
         *solved = Working::of(
             &modes,
             working_machine_mode(&modes),

@@ -269,6 +269,8 @@ struct Plan<'a> {
     units: Units,
     delimiter: u8,
     file: &'a str,
+    /// The column of each row's line in its original file (CL input), see `table::line_of`.
+    line_column: Option<usize>,
 }
 
 /// Progress callback: rows done so far.
@@ -331,6 +333,7 @@ pub fn run<J: RowJob>(
         units,
         delimiter: sink.delimiter(),
         file: &file,
+        line_column: source.line_column(),
     };
     // The loop runs on one of rayon's workers (`rayon::scope` moves it there from the calling
     // thread, which then waits once for the whole run): its joins hand work to the other worker
@@ -412,7 +415,7 @@ fn process<J: RowJob>(
     if let Some(row) = rows.iter().find(|r| r.not_a_number.is_some()) {
         let k = row.not_a_number.unwrap_or(0);
         let field = row.record.get(plan.idx[k]).unwrap_or(b"");
-        let line = row.record.position().map(|p| p.line());
+        let line = crate::table::line_of(&row.record, plan.line_column);
         let unit = match (plan.inputs[k].1, plan.units.radians) {
             (false, _) => " (mm)",
             (true, true) => " (radians)",
@@ -433,7 +436,7 @@ fn process<J: RowJob>(
     let mut scratch = Vec::new();
     for (i, row) in rows.iter().enumerate() {
         summary.input_rows += 1;
-        let line = row.record.position().map(|p| p.line()).unwrap_or(0);
+        let line = crate::table::line_of(&row.record, plan.line_column).unwrap_or(0);
         let mut writer = RowWriter {
             input: i as u32,
             out_input: &mut batch.out_input,

@@ -11,6 +11,7 @@ use std::sync::{Arc, Mutex};
 use verne_cl::{ClError, Options, Reader, Summary};
 
 use crate::error::VerneError;
+use crate::table::CsvSource;
 
 /// A CL error as the CLI's input error: file, line, column, what was expected.
 pub fn cl_error(file: &str, e: &ClError) -> VerneError {
@@ -27,38 +28,83 @@ impl<T: BufRead + Seek + Send> SeekableInput for T {}
 /// A CL reader over a boxed input, as the CLI reads files and stdin alike.
 pub type ClReader = Reader<Box<dyn SeekableInput>>;
 
-/// Opens `path` (or stdin for `None` or `-`) as a CL file: the caller decided it is one (by
-/// its name, `verne_cl::has_cl_extension`, or `--input-format apt`); a file that is not is
-/// refused by the reader at its first unknown line. Stdin is read into memory first (the
-/// units look-ahead reads the records twice).
-pub fn open_cl(path: Option<&Path>, options: Options) -> Result<(ClReader, String), VerneError> {
-    let (input, name): (Box<dyn SeekableInput>, String) = match path {
-        Some(p) if p.as_os_str() != "-" => {
-            let name = p.display().to_string();
-            let f = std::fs::File::open(p).map_err(|e| VerneError::io(&name, e))?;
-            (
-                Box::new(std::io::BufReader::with_capacity(64 * 1024, f)),
-                name,
-            )
-        }
-        _ => {
-            let name = "<stdin>".to_string();
-            let mut text = Vec::new();
-            std::io::stdin()
-                .lock()
-                .read_to_end(&mut text)
-                .map_err(|e| VerneError::io(&name, e))?;
-            (Box::new(std::io::Cursor::new(text)), name)
-        }
-    };
-    let reader = Reader::new(input, options).map_err(|e| cl_error(&name, &e))?;
-    Ok((reader, name))
+/// An input of `verne ik` or `verne verify --path`, opened as what it is.
+pub enum PathInput {
+    /// A CL file, with its name for messages.
+    Cl(Box<ClReader>, String),
+    /// Anything else: CSV.
+    Csv(CsvSource),
 }
 
-/// Prints what the reader saw besides the rows to stderr, prefixed `verne CMD: NAME:`: the
-/// units and where they came from, every warning, the records skipped. Nothing is dropped
-/// silently: a warning the reader stopped keeping is counted.
-pub fn report_summary(cmd: &str, name: &str, s: &Summary) {
+/// Opens `path` (or stdin for `None` or `-`) as a CL file or as CSV. `force` (`--input-format`)
+/// decides when given; else a CL extension (`verne_cl::has_cl_extension`) or, failing that,
+/// the first [`verne_cl::SNIFF_BYTES`] bytes (`verne_cl::sniff_content`: a first record such as
+/// `TOOL PATH/`, `PARTNO`, `$$`, `GOTO/`) make it a CL file, so that a CL file is never parsed
+/// as CSV. A CL file on stdin is read into memory (the units look-ahead reads it twice).
+pub fn open_path_input(
+    path: Option<&Path>,
+    force: Option<bool>,
+    options: Options,
+) -> Result<PathInput, VerneError> {
+    let file = path.filter(|p| p.as_os_str() != "-");
+    let name = file.map_or("<stdin>".to_string(), |p| p.display().to_string());
+    let by_name = file.is_some_and(|p| verne_cl::has_cl_extension(&p.to_string_lossy()));
+    if force == Some(false) || (force.is_none() && !by_name && file.is_some()) {
+        // A file without a CL extension: its first bytes decide (unless forced to CSV).
+        if force.is_none()
+            && let Some(p) = file
+        {
+            let mut head = Vec::with_capacity(verne_cl::SNIFF_BYTES);
+            let f = std::fs::File::open(p).map_err(|e| VerneError::io(&name, e))?;
+            f.take(verne_cl::SNIFF_BYTES as u64)
+                .read_to_end(&mut head)
+                .map_err(|e| VerneError::io(&name, e))?;
+            if verne_cl::sniff_content(&head) {
+                return open_cl_file(p, &name, options);
+            }
+        }
+        return Ok(PathInput::Csv(CsvSource::open(path)?));
+    }
+    if let Some(p) = file {
+        return open_cl_file(p, &name, options);
+    }
+    // Stdin: look at its start, then read on as whichever it is.
+    let mut stdin = std::io::stdin().lock();
+    let mut head = Vec::with_capacity(verne_cl::SNIFF_BYTES);
+    (&mut stdin)
+        .take(verne_cl::SNIFF_BYTES as u64)
+        .read_to_end(&mut head)
+        .map_err(|e| VerneError::io(&name, e))?;
+    if force.is_none() && !verne_cl::sniff_content(&head) {
+        drop(stdin);
+        let rest = std::io::Cursor::new(head).chain(std::io::stdin());
+        return Ok(PathInput::Csv(CsvSource::from_reader(
+            Box::new(rest),
+            &name,
+        )?));
+    }
+    stdin
+        .read_to_end(&mut head)
+        .map_err(|e| VerneError::io(&name, e))?;
+    let input: Box<dyn SeekableInput> = Box::new(std::io::Cursor::new(head));
+    let reader = Reader::new(input, options).map_err(|e| cl_error(&name, &e))?;
+    Ok(PathInput::Cl(Box::new(reader), name))
+}
+
+fn open_cl_file(path: &Path, name: &str, options: Options) -> Result<PathInput, VerneError> {
+    let f = std::fs::File::open(path).map_err(|e| VerneError::io(name, e))?;
+    let input: Box<dyn SeekableInput> = Box::new(std::io::BufReader::with_capacity(64 * 1024, f));
+    let reader = Reader::new(input, options).map_err(|e| cl_error(name, &e))?;
+    Ok(PathInput::Cl(Box::new(reader), name.to_string()))
+}
+
+/// Prints what the reader saw besides the rows to stderr, prefixed `verne CMD: NAME:`: every
+/// warning, the rows, dialect and units, the records skipped (names only, one line, shortened
+/// past [`SKIPPED_SHOWN`] kinds) and the tool changes. Nothing is dropped silently: a warning
+/// or tool change the reader stopped keeping is counted.
+/// `tool_length` is the length the joints were computed with: a tool length the file gives
+/// (NX `TLDATA`) that differs from it is a warning, since it is not applied.
+pub fn report_summary(cmd: &str, name: &str, s: &Summary, tool_length: f64) {
     let mut err = std::io::stderr().lock();
     for w in &s.warnings {
         let _ = writeln!(err, "verne {cmd}: {name}: warning: {w}");
@@ -70,17 +116,63 @@ pub fn report_summary(cmd: &str, name: &str, s: &Summary) {
             s.warnings_dropped
         );
     }
+    let mut line = format!(
+        "verne {cmd}: {name}: {} rows ({} dialect, {})",
+        s.rows,
+        s.dialect.as_str(),
+        s.units.as_str(),
+    );
     if !s.skipped.is_empty() {
         let skipped: Vec<String> = s.skipped.iter().map(|(k, n)| format!("{k} x{n}")).collect();
-        let _ = writeln!(
-            err,
-            "verne {cmd}: {name}: {} rows ({} dialect, {}); records skipped: {}",
-            s.rows,
-            s.dialect.as_str(),
-            s.units.as_str(),
-            skipped.join(", ")
-        );
+        line.push_str("; records skipped: ");
+        line.push_str(&shortened(&skipped, SKIPPED_SHOWN));
     }
+    let _ = writeln!(err, "{line}");
+    if s.tools.len() > 1 || s.tools.iter().any(|t| t.length_mm.is_some()) {
+        for t in &s.tools {
+            let mut what = match (t.tool, &t.name) {
+                (Some(n), Some(name)) => format!("tool {n} ({name})"),
+                (Some(n), None) => format!("tool {n}"),
+                (None, Some(name)) => format!("tool {name}"),
+                (None, None) => "a tool".to_string(),
+            };
+            if let Some(l) = t.length_mm {
+                // Inch files give lengths like 76.19999999999999: a micrometre is enough.
+                let l = (l * 1e6).round() / 1e6;
+                what.push_str(&format!(", length {l} mm in the file"));
+                if (l - tool_length).abs() > 1e-6 {
+                    let _ = writeln!(
+                        err,
+                        "verne {cmd}: {name}: warning: line {}: the file's tool length {l} mm is not the {tool_length} mm the joints were computed with (machine file or --tool-length)",
+                        t.line
+                    );
+                }
+            }
+            let _ = writeln!(
+                err,
+                "verne {cmd}: {name}: line {}: {what}, rows from line {}",
+                t.line, t.first_row_line
+            );
+        }
+        if s.tools_dropped > 0 {
+            let _ = writeln!(
+                err,
+                "verne {cmd}: {name}: {} more tool changes not shown",
+                s.tools_dropped
+            );
+        }
+    }
+}
+
+/// How many kinds of skipped record the summary line names before "and N more".
+const SKIPPED_SHOWN: usize = 24;
+
+/// `items` joined by commas, the first `n` of them and then "and K more".
+fn shortened(items: &[String], n: usize) -> String {
+    if items.len() <= n {
+        return items.join(", ");
+    }
+    format!("{}, and {} more", items[..n].join(", "), items.len() - n)
 }
 
 /// A CL file read as CSV text (`line,kind,motion,feed,tool,x,y,z,i,j,k`, mm, unit axis), so
@@ -154,6 +246,13 @@ impl ClAsCsv {
                 self.finished = true;
                 if let Ok(mut s) = self.summary.lock() {
                     *s = self.reader.summary().clone();
+                }
+                if self.reader.summary().rows == 0 {
+                    // As an empty CSV is: nothing to convert is not a success.
+                    return Err(std::io::Error::new(
+                        std::io::ErrorKind::InvalidData,
+                        "no motion record (GOTO, FROM, CIRCLE, GODLTA or a cycle): no tool pose to convert",
+                    ));
                 }
                 Ok(())
             }

@@ -12,7 +12,7 @@ use verne::parallel_module::equations::Sliders;
 use verne::verify::{Item, JOINT_NAMES, JointSource, Joints, PathPoint, RowSource};
 
 use crate::error::VerneError;
-use crate::input::cl::{ClReader, cl_error, open_cl};
+use crate::input::cl::{ClReader, PathInput, cl_error, open_path_input};
 use crate::table::{CellError, CsvSource, parse_number};
 
 /// Reads a cell as a number; a non-number is fatal (file, line, column), an empty or non-finite
@@ -83,29 +83,44 @@ enum PathKind {
     },
 }
 
-/// The intended path: a CSV (`x,y,z` and `i,j,k` or `phi1,phi2` in degrees, optional `id`) or an
-/// APT CL file (FROM and GOTO records in file order; a 3-value record has the axis (0, 0, 1)).
+/// The intended path: a CSV (`x,y,z` and `i,j,k` or `phi1,phi2` in degrees, optional `id`) or a
+/// CL file (its rows in file order, with rapid/feed and the feed of each move).
 pub struct PathReader {
     kind: PathKind,
     name: String,
     index: u64,
+    /// Where the part sits on the table (mm): added to every tip.
+    offset: Vector3<f64>,
 }
 
 impl PathReader {
-    /// Opens a path file: a CL file by its name (`verne_cl::has_cl_extension`: .cl, .cls, .apt,
-    /// .ncl, .aptsource, ...) in any dialect of `docs/cl-dialects.md`, anything else as CSV.
-    pub fn open(path: &Path) -> Result<PathReader, VerneError> {
-        if verne_cl::has_cl_extension(&path.to_string_lossy()) {
-            let (reader, name) = open_cl(Some(path), verne_cl::Options::default())?;
-            return Ok(PathReader {
-                kind: PathKind::Cl {
-                    reader: Box::new(reader),
-                },
+    /// Opens a path file: a CL file (by its extension or its first record, any dialect of
+    /// `docs/cl-dialects.md`) or CSV. `offset` (mm) is added to every tip.
+    pub fn open(
+        path: &Path,
+        options: verne_cl::Options,
+        offset: Vector3<f64>,
+    ) -> Result<PathReader, VerneError> {
+        let mut reader = match open_path_input(Some(path), None, options)? {
+            PathInput::Cl(reader, name) => PathReader {
+                kind: PathKind::Cl { reader },
                 name,
                 index: 0,
-            });
+                offset,
+            },
+            PathInput::Csv(src) => Self::from_csv(src)?,
+        };
+        reader.offset = offset;
+        Ok(reader)
+    }
+
+    /// What the CL reader saw besides the rows (complete once the rows are read), and the
+    /// file's name; `None` for a CSV path.
+    pub fn cl_summary(&self) -> Option<(&str, &verne_cl::Summary)> {
+        match &self.kind {
+            PathKind::Cl { reader } => Some((&self.name, reader.summary())),
+            PathKind::Csv { .. } => None,
         }
-        Self::from_csv(CsvSource::open(Some(path))?)
     }
 
     /// A CSV path from an opened source.
@@ -129,6 +144,7 @@ impl PathReader {
                 rec: ByteRecord::new(),
             },
             index: 0,
+            offset: Vector3::zeros(),
         })
     }
 }
@@ -224,8 +240,10 @@ impl RowSource for PathReader {
                 let axis = Vector3::from(row.axis);
                 let value = unit_axis(&axis)
                     .map(|axis| PathPoint {
-                        tip: Vector3::from(row.tip),
+                        tip: Vector3::from(row.tip) + self.offset,
                         axis,
+                        rapid: row.motion == verne_cl::Motion::Rapid,
+                        feed: row.feed_mm_min.map(|f| f / 60.0),
                     })
                     .map_err(|e| format!("{} at line {}: {e}", row.kind, row.line));
                 Ok(Some(Item {
@@ -274,15 +292,15 @@ impl RowSource for PathReader {
                 }
                 let id =
                     id.map(|i| String::from_utf8_lossy(rec.get(i).unwrap_or(b"")).into_owned());
-                let tip = Vector3::new(v[0], v[1], v[2]);
+                let tip = Vector3::new(v[0], v[1], v[2]) + self.offset;
                 let value = match bad {
                     Some(e) => Err(e),
-                    None if *angles => Ok(PathPoint {
+                    None if *angles => Ok(PathPoint::new(
                         tip,
-                        axis: tool_axis(v[3].to_radians(), v[4].to_radians()),
-                    }),
+                        tool_axis(v[3].to_radians(), v[4].to_radians()),
+                    )),
                     None => unit_axis(&Vector3::new(v[3], v[4], v[5]))
-                        .map(|axis| PathPoint { tip, axis })
+                        .map(|axis| PathPoint::new(tip, axis))
                         .map_err(|e| e.to_string()),
                 };
                 Ok(Some(Item {

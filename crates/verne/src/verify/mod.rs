@@ -143,11 +143,30 @@ impl Joints {
     }
 }
 
-/// One intended tool pose in the workpiece frame: tip (mm) and unit axis (tip towards spindle).
+/// One intended tool pose in the workpiece frame: tip (mm) and unit axis (tip towards spindle),
+/// and how the path moves to it when the path says so (CL files do; CSV paths do not).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PathPoint {
     pub tip: Vector3<f64>,
     pub axis: Vector3<f64>,
+    /// The move to this point is a rapid (positioning) move: the controller does not follow the
+    /// straight line, so the joint-jump and chordal-error checks do not apply to it.
+    pub rapid: bool,
+    /// The programmed feed of the move to this point (mm/s), when the path gives one: the speed
+    /// checks use it when the joint table has no `t` or `feed`.
+    pub feed: Option<f64>,
+}
+
+impl PathPoint {
+    /// A point of a path that says nothing about its moves (a feed move at an unknown feed).
+    pub fn new(tip: Vector3<f64>, axis: Vector3<f64>) -> PathPoint {
+        PathPoint {
+            tip,
+            axis,
+            rapid: false,
+            feed: None,
+        }
+    }
 }
 
 /// A row as read: where it is, its id, and its values or why they are unusable.
@@ -468,6 +487,10 @@ where
                 continue;
             };
             summary.segments += 1;
+            if seg.dt > 0.0 {
+                // Timed by the joint table, or by the path's feeds.
+                summary.timed = true;
+            }
             if let (Some(flip), Some(p)) = (seg.flip, &prev_seg)
                 && let Some(pf) = p.flip
                 && pf * flip < 0.0

@@ -74,6 +74,9 @@ pub(super) fn eval_segment(m: &Machine, opt: &VerifyOptions, a: &RowEval, b: &Ro
         s.flip = Some(dtheta2);
         return s;
     }
+    // A rapid move is not interpolated along the line by the controller: no jump, chord or
+    // speed check (its speed is the machine's rapid rate, not a programmed feed).
+    let rapid = pb.rapid;
     // 6. Joint jumps.
     let step = th.per_joint(Th::RhoStepMm, Th::Theta1StepDeg, Th::Theta2StepDeg);
     let mut jumped = false;
@@ -88,7 +91,7 @@ pub(super) fn eval_segment(m: &Machine, opt: &VerifyOptions, a: &RowEval, b: &Ro
             &mut worst,
             Obs::over(Check::JointJump, v, l, JOINT_NAMES[i]),
         );
-        if dq[i].abs() > step[i] {
+        if dq[i].abs() > step[i] && !rapid {
             let (v, l, u) = if i < 3 {
                 (dq[i].abs(), step[i], "mm")
             } else {
@@ -108,13 +111,16 @@ pub(super) fn eval_segment(m: &Machine, opt: &VerifyOptions, a: &RowEval, b: &Ro
             jumped = true;
         }
     }
-    s.obs.extend(worst);
+    if !rapid {
+        s.obs.extend(worst);
+    }
     if jumped {
         return s;
     }
-    // 6. Velocities.
-    let dt = match (qa.t, qb.t, qb.feed) {
+    // 6. Velocities: from the joint table's time or feed, else from the path's feed.
+    let dt = match (qa.t, qb.t, qb.feed.or(pb.feed)) {
         (Some(ta), Some(tb), _) => Some(tb - ta),
+        _ if rapid => None,
         (_, _, Some(f)) if f > 0.0 => Some((pb.tip - pa.tip).norm() / f),
         _ => None,
     };
@@ -233,7 +239,7 @@ fn interior(
             ));
             return;
         }
-        if j == half {
+        if j == half && !pb.rapid {
             let q1 = qa.theta1 + (qb.theta1 - qa.theta1) * 0.5;
             let q2 = qa.theta2 + (qb.theta2 - qa.theta2) * 0.5;
             let tip = tool_pose_eq26(&m.table, &pose, q1, q2, opt.tool_length).tip;
