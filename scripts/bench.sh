@@ -176,7 +176,7 @@ fi
 KERNEL_TABLE=""
 if [ "$KERNELS" = 1 ]; then
     log "cargo bench -p verne-cli --bench kernels (a few minutes)"
-    VERNE_BENCH_SUMMARY="$WORK/kernels.md" cargo bench -p verne-cli --bench kernels >"$WORK/kernels.log" 2>&1
+    VERNE_BENCH_SUMMARY="$(realpath -m "$WORK/kernels.md")" cargo bench -p verne-cli --bench kernels >"$WORK/kernels.log" 2>&1
     KERNEL_TABLE=$(cat "$WORK/kernels.md")
 fi
 

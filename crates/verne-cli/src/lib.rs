@@ -6,6 +6,24 @@
 //!
 //! `src/main.rs` only calls [`run`].
 
+/// `eprint!` that never panics: a message to a closed stderr (`verne ik F 2>&1 | head -1`) is
+/// dropped, and the run exits with the code it would have had. Every message of the CLI goes
+/// through it (or through `writeln!` with its result ignored).
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = write!(std::io::stderr(), $($arg)*);
+    }};
+}
+
+/// [`say!`] with a newline.
+macro_rules! sayln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($arg)*);
+    }};
+}
+
 pub mod arg_values;
 pub mod cli;
 pub mod cmd;
@@ -60,7 +78,7 @@ pub fn run() -> ExitCode {
         Err(e) if e.is_broken_pipe() => ExitCode::from(cmd::EXIT_OK),
         Err(e) => {
             table::remove_temp_files();
-            eprintln!("verne: error: {e}");
+            sayln!("verne: error: {e}");
             ExitCode::from(cmd::EXIT_FATAL)
         }
     }

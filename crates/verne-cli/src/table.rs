@@ -32,14 +32,17 @@ impl CsvSource {
             Some(p) if p.as_os_str() == "-" => Self::from_reader(Box::new(io::stdin()), "<stdin>"),
             Some(p) => {
                 let name = p.display().to_string();
-                let f = File::open(p).map_err(|e| VerneError::io(&name, e))?;
+                let f = open_input_file(p).map_err(|e| VerneError::io(&name, e))?;
                 Self::from_reader(Box::new(io::BufReader::with_capacity(1 << 16, f)), &name)
             }
         }
     }
 
-    /// Reads CSV text from any reader; `name` is used in error messages.
+    /// Reads CSV text from any reader; `name` is used in error messages. Line ends are made
+    /// `\n` first ([`LfLines`]), so that every line number in a message is the file's line,
+    /// whether it ends lines with LF, CRLF or CR.
     pub fn from_reader(r: Box<dyn Read + Send>, name: &str) -> Result<CsvSource, VerneError> {
+        let r: Box<dyn Read + Send> = Box::new(LfLines::new(r));
         let mut reader = csv::ReaderBuilder::new()
             .has_headers(true)
             // Fields are trimmed by `read` without the per-record allocation of Trim::All.
@@ -272,6 +275,7 @@ impl Sink {
         let (writer, target, name): (Box<dyn Write + Send>, _, String) = match path {
             Some(p) if p.as_os_str() != "-" => {
                 let name = p.display().to_string();
+                check_output_target(p).map_err(|e| VerneError::io(&name, e))?;
                 let dest = output_destination(p);
                 if dest.in_place {
                     let f = std::fs::OpenOptions::new()
@@ -367,7 +371,7 @@ impl Sink {
         if let Some((tmp, dest)) = self.target.take() {
             // Close the file before renaming.
             drop(std::mem::replace(&mut self.writer, Box::new(io::sink())));
-            let renamed = std::fs::rename(&tmp, &dest);
+            let renamed = keep_attributes(&dest, &tmp).and_then(|_| std::fs::rename(&tmp, &dest));
             unregister_temp(&tmp);
             if let Err(e) = renamed {
                 let _ = std::fs::remove_file(&tmp);
@@ -415,6 +419,15 @@ pub fn output_destination(path: &Path) -> OutputDestination {
             path: std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf()),
             in_place: false,
         },
+        // A symlink to a file not there yet: the file is created where the link points.
+        Err(_) if path.is_symlink() => OutputDestination {
+            path: match std::fs::read_link(path) {
+                Ok(t) if t.is_relative() => path.parent().map_or(t.clone(), |d| d.join(&t)),
+                Ok(t) => t,
+                Err(_) => path.to_path_buf(),
+            },
+            in_place: false,
+        },
         _ => OutputDestination {
             path: path.to_path_buf(),
             in_place: false,
@@ -422,16 +435,87 @@ pub fn output_destination(path: &Path) -> OutputDestination {
     }
 }
 
+/// Before a temporary file replaces `dest`: the mode and owner (owner only as root) of an
+/// existing `dest` are given to the temporary file, so that the output keeps them. A hard link to `dest` keeps the
+/// old content: the new file replaces the name, not the inode (docs/csv.md).
+fn keep_attributes(dest: &Path, tmp: &Path) -> io::Result<()> {
+    use std::os::unix::fs::MetadataExt;
+    use std::os::unix::fs::PermissionsExt;
+    let Ok(m) = std::fs::metadata(dest) else {
+        return Ok(());
+    };
+    if !m.is_file() {
+        return Ok(());
+    }
+    std::fs::set_permissions(tmp, std::fs::Permissions::from_mode(m.permissions().mode()))?;
+    // Only root can give a file away; for anyone else the owner is already theirs.
+    let _ = std::os::unix::fs::chown(tmp, Some(m.uid()), Some(m.gid()));
+    Ok(())
+}
+
+/// The files this run reads (device and inode), so that no output replaces one of them.
+static INPUT_FILES: std::sync::Mutex<Vec<(u64, u64)>> = std::sync::Mutex::new(Vec::new());
+
+/// Opens an input file for reading and remembers it as an input of this run (see
+/// `check_output_target`). Every command opens its input files through here.
+pub fn open_input_file(path: &Path) -> io::Result<File> {
+    let f = File::open(path)?;
+    if let Ok(m) = f.metadata()
+        && m.is_file()
+        && let Ok(mut v) = INPUT_FILES.lock()
+    {
+        use std::os::unix::fs::MetadataExt;
+        v.push((m.dev(), m.ino()));
+    }
+    Ok(f)
+}
+
+/// Reads a whole input file, remembered as [`open_input_file`] does.
+pub fn read_input_file(path: &Path) -> io::Result<Vec<u8>> {
+    let mut bytes = Vec::new();
+    open_input_file(path)?.read_to_end(&mut bytes)?;
+    Ok(bytes)
+}
+
+/// Checks an output file before anything is computed or written: one of this run's input files
+/// (the same file under any name: a hard or symbolic link too) is refused, since the run would
+/// replace what it reads; so is an existing file without any write permission (root could
+/// otherwise replace it).
+fn check_output_target(path: &Path) -> io::Result<()> {
+    use std::os::unix::fs::{MetadataExt, PermissionsExt};
+    let Ok(m) = std::fs::metadata(path) else {
+        return Ok(());
+    };
+    if m.is_file() && m.permissions().mode() & 0o222 == 0 {
+        return Err(io::Error::new(
+            io::ErrorKind::PermissionDenied,
+            "the file is read-only: refusing to replace it (make it writable, or name another file)",
+        ));
+    }
+    let same = INPUT_FILES
+        .lock()
+        .map(|v| v.contains(&(m.dev(), m.ino())))
+        .unwrap_or(false);
+    if same && m.is_file() {
+        return Err(io::Error::other(
+            "is an input of this run: refusing to overwrite it with the output (name another file)",
+        ));
+    }
+    Ok(())
+}
+
 /// Writes `bytes` as the output file `path`, as [`Sink`] does: through a temporary file beside
 /// it, renamed into place (nothing is left behind on an error), or in place for a device or a
 /// FIFO ([`output_destination`]).
 pub fn write_output(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    check_output_target(path)?;
     let dest = output_destination(path);
     if dest.in_place {
         return std::fs::write(&dest.path, bytes);
     }
     let tmp = temp_path_for(&dest.path);
     std::fs::write(&tmp, bytes)
+        .and_then(|_| keep_attributes(&dest.path, &tmp))
         .and_then(|_| std::fs::rename(&tmp, &dest.path))
         .inspect_err(|_| {
             let _ = std::fs::remove_file(&tmp);
@@ -491,6 +575,88 @@ pub fn format_number(out: &mut Vec<u8>, v: f64, decimals: Option<usize>) {
     }
 }
 
+/// CSV text with its line ends made `\n`: CRLF and a lone CR outside quoted fields become one
+/// LF (inside quotes they are data and pass through). The csv crate counts lines by LF only,
+/// one too few after each CRLF record and none in a CR-only file; after this, its line numbers
+/// are the file's. Text without CR or quotes passes through untouched (one memchr2 per read).
+pub struct LfLines<R> {
+    inner: R,
+    /// Inside a quoted field (an escaped `""` toggles twice).
+    quoted: bool,
+    /// The last byte was a CR turned into LF: an LF right after it belongs to it.
+    after_cr: bool,
+}
+
+impl<R: Read> LfLines<R> {
+    pub fn new(inner: R) -> LfLines<R> {
+        LfLines {
+            inner,
+            quoted: false,
+            after_cr: false,
+        }
+    }
+
+    /// Rewrites `buf` in place; returns its new length.
+    fn convert(&mut self, buf: &mut [u8]) -> usize {
+        let n = buf.len();
+        let mut r = 0;
+        if self.after_cr && n > 0 {
+            self.after_cr = false;
+            if buf[0] == b'\n' {
+                r = 1;
+            }
+        }
+        let mut w = 0;
+        while r < n {
+            // Copy up to the next byte that matters.
+            let next = memchr::memchr2(b'\r', b'"', &buf[r..]).map_or(n, |k| r + k);
+            if w != r {
+                buf.copy_within(r..next, w);
+            }
+            w += next - r;
+            r = next;
+            if r == n {
+                break;
+            }
+            match buf[r] {
+                b'"' => {
+                    self.quoted = !self.quoted;
+                    buf[w] = b'"';
+                }
+                _ if self.quoted => buf[w] = b'\r',
+                _ => {
+                    buf[w] = b'\n';
+                    if r + 1 < n {
+                        if buf[r + 1] == b'\n' {
+                            r += 1;
+                        }
+                    } else {
+                        self.after_cr = true;
+                    }
+                }
+            }
+            w += 1;
+            r += 1;
+        }
+        w
+    }
+}
+
+impl<R: Read> Read for LfLines<R> {
+    fn read(&mut self, out: &mut [u8]) -> io::Result<usize> {
+        loop {
+            let n = self.inner.read(out)?;
+            if n == 0 {
+                return Ok(0);
+            }
+            let w = self.convert(&mut out[..n]);
+            if w > 0 {
+                return Ok(w);
+            }
+        }
+    }
+}
+
 /// The line a record comes from: the value of `line_column` when the rows come from another
 /// file (a CL file read as CSV), else the record's line in the CSV text.
 pub fn line_of(record: &ByteRecord, line_column: Option<usize>) -> Option<u64> {
@@ -505,6 +671,44 @@ pub fn line_of(record: &ByteRecord, line_column: Option<usize>) -> Option<u64> {
 
 #[cfg(test)]
 pub(crate) mod tests {
+    /// Every split of the input into reads gives the same text: LF, CRLF and CR lines alike,
+    /// quoted CR and CRLF kept.
+    #[test]
+    fn lf_lines_normalizes_line_ends_outside_quotes() {
+        use std::io::Read;
+        let cases: [(&[u8], &[u8]); 5] = [
+            (b"a,b\r\n1,2\r\n", b"a,b\n1,2\n"),
+            (b"a,b\r1,2\r3,4", b"a,b\n1,2\n3,4"),
+            (b"a\n\r\n\r\rb", b"a\n\n\n\nb"),
+            (b"\"x\r\ny\"\r\n\"q\"\"\r\"\r", b"\"x\r\ny\"\n\"q\"\"\r\"\n"),
+            (b"no line end", b"no line end"),
+        ];
+        /// A reader that hands out at most `k` bytes a call.
+        struct Chunks<'a>(&'a [u8], usize);
+        impl Read for Chunks<'_> {
+            fn read(&mut self, out: &mut [u8]) -> std::io::Result<usize> {
+                let n = self.0.len().min(self.1).min(out.len());
+                out[..n].copy_from_slice(&self.0[..n]);
+                self.0 = &self.0[n..];
+                Ok(n)
+            }
+        }
+        for (input, want) in cases {
+            for k in 1..=input.len() {
+                let mut got = Vec::new();
+                super::LfLines::new(Chunks(input, k))
+                    .read_to_end(&mut got)
+                    .unwrap();
+                assert_eq!(
+                    got,
+                    want,
+                    "{:?} in reads of {k}",
+                    String::from_utf8_lossy(input)
+                );
+            }
+        }
+    }
+
     use super::*;
 
     /// The sink's encoding is byte for byte the csv crate's writer's, on random records of

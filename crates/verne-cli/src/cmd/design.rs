@@ -83,16 +83,18 @@ pub fn run(args: &DesignArgs) -> Result<u8, VerneError> {
     };
     write_stdout(&text)?;
     if !is_paper {
-        eprintln!(
+        sayln!(
             "verne design: bounds {},{} are not the paper's 1/3,3: its values are not shown",
-            args.bounds[0], args.bounds[1]
+            args.bounds[0],
+            args.bounds[1]
         );
     }
     for name in &missing {
-        eprintln!(
+        sayln!(
             "verne design: {name}: no dimensions meet {} <= lambda_i <= {} at the \
              configurations of section 3.2",
-            args.bounds[0], args.bounds[1]
+            args.bounds[0],
+            args.bounds[1]
         );
     }
     Ok(if missing.is_empty() {

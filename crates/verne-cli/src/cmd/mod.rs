@@ -35,7 +35,7 @@ pub fn load_machine(path: Option<&Path>) -> Result<Machine, VerneError> {
         Some(p) if !p.exists() && p.as_os_str() == "verne" => Ok(Machine::default_verne()),
         Some(p) => {
             let name = p.display().to_string();
-            let text = std::fs::read(p).map_err(|e| VerneError::io(&name, e))?;
+            let text = crate::table::read_input_file(p).map_err(|e| VerneError::io(&name, e))?;
             let text = String::from_utf8(text).map_err(|e| {
                 let upto = &e.as_bytes()[..e.utf8_error().valid_up_to()];
                 let line = upto.iter().filter(|&&b| b == b'\n').count() as u64 + 1;
@@ -130,14 +130,14 @@ fn report(command: &str, file: &str, s: &RunSummary) {
         return;
     }
     let counts: Vec<String> = s.not_ok.iter().map(|(st, n)| format!("{n} {st}")).collect();
-    eprintln!(
+    sayln!(
         "verne {command}: {file}: {} of {} rows not ok ({})",
         s.input_rows - s.ok_rows,
         s.input_rows,
         counts.join(", ")
     );
     for (line, st) in &s.first_failures {
-        eprintln!("  {file}:{line}: {st}");
+        sayln!("  {file}:{line}: {st}");
     }
 }
 

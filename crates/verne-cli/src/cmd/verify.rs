@@ -72,7 +72,7 @@ pub fn run(args: &VerifyArgs) -> Result<u8, VerneError> {
     if let Some((name, s)) = path.cl_summary() {
         crate::input::cl::report_summary("verify", name, s, opt.tool_length);
     }
-    eprint!(
+    say!(
         "verne verify: {} against {}: {}",
         args.joints.display(),
         args.path.display(),

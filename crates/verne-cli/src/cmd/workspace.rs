@@ -200,7 +200,7 @@ pub fn run(args: &WorkspaceArgs) -> Result<u8, VerneError> {
         }
     }
     if to_stdout {
-        eprint!("{out}");
+        say!("{out}");
     } else {
         write_stdout(&out)?;
     }

@@ -140,10 +140,14 @@ impl RowJob for GliderFk {
             Some(ForwardKinematics::StructuralSingularity { centre, radius }) => {
                 self.structural += 1;
                 if self.structural <= MAX_STRUCTURAL_REPORTS {
-                    eprintln!(
+                    sayln!(
                         "verne fk: rho = ({}, {}): structural singularity: C = D = ({}, {}), \
                          P is anywhere on the circle of radius {} about it",
-                        s.rho[0], s.rho[1], centre.x, centre.y, radius
+                        s.rho[0],
+                        s.rho[1],
+                        centre.x,
+                        centre.y,
+                        radius
                     );
                 }
                 return fail("structural_singularity", out);

@@ -55,7 +55,7 @@ pub fn open_path_input(
             && let Some(p) = file
         {
             let mut head = Vec::with_capacity(verne_cl::SNIFF_BYTES);
-            let f = std::fs::File::open(p).map_err(|e| VerneError::io(&name, e))?;
+            let f = crate::table::open_input_file(p).map_err(|e| VerneError::io(&name, e))?;
             f.take(verne_cl::SNIFF_BYTES as u64)
                 .read_to_end(&mut head)
                 .map_err(|e| VerneError::io(&name, e))?;
@@ -92,7 +92,7 @@ pub fn open_path_input(
 }
 
 fn open_cl_file(path: &Path, name: &str, options: Options) -> Result<PathInput, VerneError> {
-    let f = std::fs::File::open(path).map_err(|e| VerneError::io(name, e))?;
+    let f = crate::table::open_input_file(path).map_err(|e| VerneError::io(name, e))?;
     let input: Box<dyn SeekableInput> = Box::new(std::io::BufReader::with_capacity(64 * 1024, f));
     let reader = Reader::new(input, options).map_err(|e| cl_error(name, &e))?;
     Ok(PathInput::Cl(Box::new(reader), name.to_string()))

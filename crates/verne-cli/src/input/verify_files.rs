@@ -179,11 +179,19 @@ impl RowSource for JointReader {
                 }
             }
         }
-        let optional =
+        // A time or feed column, once present, must hold a finite number on every row: a row
+        // whose time cannot be read is an `input` finding, never a segment left unchecked.
+        let mut optional =
             |i: Option<usize>, col: &str, unit: &str| -> Result<Option<f64>, VerneError> {
                 match i {
                     None => Ok(None),
-                    Some(i) => Ok(cell(&name, &self.rec, i, col, unit)?.ok()),
+                    Some(i) => match cell(&name, &self.rec, i, col, unit)? {
+                        Ok(x) => Ok(Some(x)),
+                        Err(e) => {
+                            bad.get_or_insert(e);
+                            Ok(None)
+                        }
+                    },
                 }
             };
         let t = optional(self.t, "t", "s")?;

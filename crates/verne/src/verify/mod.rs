@@ -223,9 +223,9 @@ pub enum PairingError {
         line: u64,
         index: u64,
     },
-    /// An id appears twice in the intended path.
+    /// An id appears twice in one input (`file`: the joint table or the intended path).
     DuplicateId {
-        path: String,
+        file: String,
         id: String,
         line: u64,
         first_line: u64,
@@ -237,9 +237,8 @@ impl PairingError {
     pub fn file(&self) -> &str {
         match self {
             PairingError::ExtraJointRow { joints, .. } => joints,
-            PairingError::ExtraPathRow { path, .. } | PairingError::DuplicateId { path, .. } => {
-                path
-            }
+            PairingError::ExtraPathRow { path, .. } => path,
+            PairingError::DuplicateId { file, .. } => file,
         }
     }
 
@@ -313,6 +312,8 @@ enum Pairer {
         /// Path rows read ahead, waiting for their joint row.
         pending: HashMap<String, Item<PathPoint>>,
         path_done: bool,
+        /// The line of every joint id seen: a second row with the same id is fatal.
+        joint_lines: HashMap<String, u64>,
     },
 }
 
@@ -416,6 +417,7 @@ where
         Pairer::ById {
             pending: HashMap::new(),
             path_done: false,
+            joint_lines: HashMap::new(),
         }
     } else {
         Pairer::InOrder
@@ -566,7 +568,10 @@ where
         }
     }
     // Intended rows never matched by a joint row.
-    if let Pairer::ById { pending, path_done } = &mut pairer {
+    if let Pairer::ById {
+        pending, path_done, ..
+    } = &mut pairer
+    {
         let mut rest: Vec<Item<PathPoint>> = pending.drain().map(|(_, v)| v).collect();
         if !*path_done {
             while let Some(item) = path.next_item()? {
@@ -627,11 +632,25 @@ where
                 .into()),
             }
         }
-        Pairer::ById { pending, path_done } => {
+        Pairer::ById {
+            pending,
+            path_done,
+            joint_lines,
+        } => {
             let Some(j) = joints.next_item()? else {
                 return Ok(None);
             };
             let id = j.id.clone().unwrap_or_default();
+            if let Some(&first_line) = joint_lines.get(&id) {
+                return Err(PairingError::DuplicateId {
+                    file: joints.name().to_string(),
+                    id,
+                    line: j.line,
+                    first_line,
+                }
+                .into());
+            }
+            joint_lines.insert(id.clone(), j.line);
             if let Some(p) = pending.remove(&id) {
                 return Ok(Some(Paired {
                     joints: j,
@@ -651,7 +670,7 @@ where
                         }
                         if let Some(old) = pending.get(&pid) {
                             return Err(PairingError::DuplicateId {
-                                path: path.name().to_string(),
+                                file: path.name().to_string(),
                                 id: pid,
                                 line: p.line,
                                 first_line: old.line,

@@ -41,7 +41,8 @@ impl Grid {
                 "the step must be a positive number of mm, got {step}"
             ));
         }
-        let mut n = [0usize; 3];
+        // Counted in f64 first: a tiny step or huge bounds must be refused, not wrap around.
+        let mut counts = [0f64; 3];
         for (d, name) in ["x", "y", "z"].iter().enumerate() {
             let (lo, hi) = (b.min[d], b.max[d]);
             if !(lo.is_finite() && hi.is_finite()) || lo > hi {
@@ -49,15 +50,27 @@ impl Grid {
                     "bounds: {name} range [{lo}, {hi}] is empty or not finite"
                 ));
             }
-            n[d] = ((hi - lo) / step + 1e-9).floor() as usize + 1;
+            counts[d] = ((hi - lo) / step + 1e-9).floor() + 1.0;
         }
-        let total = n.iter().map(|&v| v as u64).product::<u64>();
-        if total > MAX_GRID_POINTS {
+        let total = counts[0] * counts[1] * counts[2];
+        // NaN cannot arise (finite bounds, positive step); `>` also refuses infinity.
+        if total > MAX_GRID_POINTS as f64 {
+            let show = |c: f64| {
+                if c < 1e15 {
+                    format!("{c}")
+                } else {
+                    format!("{c:.3e}")
+                }
+            };
             return Err(format!(
-                "{} x {} x {} = {total} grid points is more than {MAX_GRID_POINTS}: increase the step or narrow the bounds",
-                n[0], n[1], n[2]
+                "{} x {} x {} = {} grid points is more than {MAX_GRID_POINTS}: increase the step or narrow the bounds",
+                show(counts[0]),
+                show(counts[1]),
+                show(counts[2]),
+                show(total)
             ));
         }
+        let n = counts.map(|c| c as usize);
         Ok(Grid {
             origin: b.min,
             step,

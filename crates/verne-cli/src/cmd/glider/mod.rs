@@ -58,7 +58,8 @@ pub fn load(machine: Option<&Path>) -> Result<Option<GliderSpec>, VerneError> {
         return Ok(p.to_str().and_then(GliderSpec::preset));
     }
     let name = p.display().to_string();
-    let text = std::fs::read_to_string(p).map_err(|e| VerneError::io(&name, e))?;
+    let bytes = crate::table::read_input_file(p).map_err(|e| VerneError::io(&name, e))?;
+    let text = String::from_utf8_lossy(&bytes);
     let is_glider = text.lines().any(|l| {
         let l = l.trim().replace(' ', "");
         l == "kind=\"glider\"" || l == "kind,glider"
@@ -117,7 +118,7 @@ pub fn fk(args: &FkArgs, spec: GliderSpec) -> Result<u8, VerneError> {
         units(&args.common),
     )?;
     if job.structural > MAX_STRUCTURAL_REPORTS {
-        eprintln!(
+        sayln!(
             "verne fk: {} rows at a structural singularity in all ({} more not shown)",
             job.structural,
             job.structural - MAX_STRUCTURAL_REPORTS

@@ -223,7 +223,7 @@ pub fn workspace(
     if let Some(p) = plot {
         let _ = writeln!(s, "  wrote the picture to {}", p.display());
     }
-    eprint!("{s}");
+    say!("{s}");
     Ok(if grid.seed.is_some() {
         EXIT_OK
     } else {

@@ -1,0 +1,246 @@
+//! The second round of hostile inputs (issue "reliability, second round"): each finding is
+//! reproduced here with the command that showed it, and the behaviour it must have now.
+
+mod common;
+
+use std::io::Read;
+use std::os::unix::fs::PermissionsExt;
+use std::path::PathBuf;
+use std::process::Stdio;
+
+use common::{command, run};
+
+fn stderr(o: &std::process::Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("verne-round2-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+/// Finding 1, a closed stderr (`verne ik data/example.cl 2>&1 | head -1`): the summary and the
+/// failing rows are dropped, the run exits with its own code (1: the file read in inches has
+/// unreachable rows), not a panic (101).
+#[test]
+fn a_closed_stderr_is_not_a_panic() {
+    let cases: [(&[&str], i32); 3] = [
+        (
+            &["ik", "--units", "in", "tests/data/cl-corpus/nx_basic.cls"],
+            1,
+        ),
+        (&["ik", "data/example.cl"], 0),
+        (&["ik", "no/such/file.csv"], 2),
+    ];
+    for (args, code) in cases {
+        let mut child = command(args).stderr(Stdio::piped()).spawn().unwrap();
+        drop(child.stderr.take()); // the reading end of stderr is closed before any message
+        drop(child.stdin.take());
+        let mut out = String::new();
+        child
+            .stdout
+            .take()
+            .unwrap()
+            .read_to_string(&mut out)
+            .unwrap();
+        let status = child.wait().unwrap();
+        assert_eq!(status.code(), Some(code), "{args:?}");
+    }
+}
+
+/// Finding 2: A joint table whose `t` is `nan`, `inf` or empty on a row is not "clean": the row is an
+/// `input` finding (exit 1).
+#[test]
+fn verify_does_not_pass_a_time_it_cannot_read() {
+    let path = scratch("path.csv");
+    std::fs::write(
+        &path,
+        "x,y,z,i,j,k\n0,0,50,0,0,1\n1,0,50,0,0,1\n2,0,50,0,0,1\n",
+    )
+    .unwrap();
+    let ik = run(&["ik", path.to_str().unwrap()], None);
+    assert_eq!(ik.status.code(), Some(0), "{}", stderr(&ik));
+    let text = String::from_utf8(ik.stdout).unwrap();
+    for bad in ["nan", "inf", ""] {
+        let mut joints = String::new();
+        for (k, line) in text.lines().enumerate() {
+            let cells: Vec<&str> = line.split(',').collect();
+            let t = match k {
+                0 => "t".to_string(),
+                2 => bad.to_string(),
+                _ => format!("{}", k as f64 * 0.1),
+            };
+            joints.push_str(&format!(
+                "{},{},{},{},{},{t}\n",
+                cells[6], cells[7], cells[8], cells[9], cells[10]
+            ));
+        }
+        let jp = scratch(&format!("joints-{bad}.csv"));
+        std::fs::write(&jp, &joints).unwrap();
+        let v = run(
+            &[
+                "verify",
+                "--joints",
+                jp.to_str().unwrap(),
+                "--path",
+                path.to_str().unwrap(),
+                "--format",
+                "json",
+            ],
+            None,
+        );
+        let out = String::from_utf8_lossy(&v.stdout);
+        assert_eq!(
+            v.status.code(),
+            Some(1),
+            "t = `{bad}`: {out} {}",
+            stderr(&v)
+        );
+        assert!(out.contains("\"clean\":false"), "t = `{bad}`: {out}");
+        assert!(out.contains("\"input\":{\"count\":1"), "t = `{bad}`: {out}");
+    }
+}
+
+/// Finding 3: Line numbers are the file's lines whatever its line ends: LF, CRLF or CR.
+#[test]
+fn line_numbers_count_crlf_and_cr_lines() {
+    for text in [
+        "xp,yp,zp\n-240,-86,1000\nbad,1,1\n",
+        "xp,yp,zp\r\n-240,-86,1000\r\nbad,1,1\r\n",
+        "xp,yp,zp\r-240,-86,1000\rbad,1,1\r",
+    ] {
+        let o = run(&["ik"], Some(text));
+        assert_eq!(o.status.code(), Some(2));
+        assert_eq!(
+            stderr(&o).lines().next().unwrap(),
+            "verne: error: <stdin>:3: column xp: expected a number (mm), found `bad`",
+            "{text:?}"
+        );
+    }
+    // The failing-rows summary too: row 2 (line 3) is out of reach.
+    let o = run(&["ik"], Some("xp,yp,zp\r\n-240,-86,1000\r\n0,0,1\r\n"));
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("<stdin>:3: "), "{}", stderr(&o));
+}
+
+/// Finding 6: A grid too large to count is refused (exit 2), not "0 points".
+#[test]
+fn a_grid_that_overflows_is_refused() {
+    for args in [
+        &["workspace", "--step", "1e-300"][..],
+        &["workspace", "--bounds", "0,1e300,0,1e300,0,1e300"][..],
+    ] {
+        let o = run(args, None);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(
+            stderr(&o).contains("grid points is more than"),
+            "{}",
+            stderr(&o)
+        );
+    }
+}
+
+/// Finding 7: An output that is an input of the run is refused before anything is written, under any
+/// name; a read-only output is refused; an existing output keeps its mode; an output through a
+/// dangling symlink is created where the link points.
+#[test]
+fn outputs_never_replace_inputs_or_read_only_files() {
+    let path = scratch("p7.csv");
+    std::fs::write(&path, "x,y,z,i,j,k\n0,0,50,0,0,1\n1,0,50,0,0,1\n").unwrap();
+    let p = path.to_str().unwrap();
+    let joints = scratch("j7.csv");
+    let j = joints.to_str().unwrap();
+    assert_eq!(run(&["ik", p, "-o", j], None).status.code(), Some(0));
+    let before = std::fs::read(&joints).unwrap();
+    // verify --report onto the joint table
+    let o = run(&["verify", "--joints", j, "--path", p, "--report", j], None);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("is an input of this run"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(std::fs::read(&joints).unwrap(), before);
+    // ik -o onto its input, by a hard link
+    let link = scratch("p7-link.csv");
+    let _ = std::fs::remove_file(&link);
+    std::fs::hard_link(&path, &link).unwrap();
+    let o = run(&["ik", p, "-o", link.to_str().unwrap()], None);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("is an input of this run"));
+    // read-only target: refused (also as root), untouched
+    let ro = scratch("ro.csv");
+    std::fs::write(&ro, "keep\n").unwrap();
+    std::fs::set_permissions(&ro, std::fs::Permissions::from_mode(0o444)).unwrap();
+    let o = run(&["ik", p, "-o", ro.to_str().unwrap()], None);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("read-only"), "{}", stderr(&o));
+    assert_eq!(std::fs::read(&ro).unwrap(), b"keep\n");
+    // 0600 target keeps 0600
+    let private = scratch("private.csv");
+    std::fs::write(&private, "old\n").unwrap();
+    std::fs::set_permissions(&private, std::fs::Permissions::from_mode(0o600)).unwrap();
+    assert_eq!(
+        run(&["ik", p, "-o", private.to_str().unwrap()], None)
+            .status
+            .code(),
+        Some(0)
+    );
+    let mode = std::fs::metadata(&private).unwrap().permissions().mode() & 0o777;
+    assert_eq!(mode, 0o600);
+    // dangling symlink: the file is made where it points, the link stays a link
+    let target = scratch("made-through-link.csv");
+    let _ = std::fs::remove_file(&target);
+    let sym = scratch("dangling.csv");
+    let _ = std::fs::remove_file(&sym);
+    std::os::unix::fs::symlink(&target, &sym).unwrap();
+    assert_eq!(
+        run(&["ik", p, "-o", sym.to_str().unwrap()], None)
+            .status
+            .code(),
+        Some(0)
+    );
+    assert!(sym.is_symlink());
+    assert!(
+        std::fs::read_to_string(&target)
+            .unwrap()
+            .starts_with("x,y,z")
+    );
+}
+
+/// Finding 8: A duplicated id in the joint table is fatal with both lines, as in the path.
+#[test]
+fn a_duplicated_joint_id_is_fatal() {
+    let path = scratch("p8.csv");
+    std::fs::write(&path, "id,x,y,z,i,j,k\na,0,0,50,0,0,1\nb,1,0,50,0,0,1\n").unwrap();
+    let ik = run(&["ik", path.to_str().unwrap()], None);
+    let text = String::from_utf8(ik.stdout).unwrap();
+    let mut joints = String::new();
+    for (k, line) in text.lines().enumerate() {
+        let c: Vec<&str> = line.split(',').collect();
+        let id = if k == 0 { "id" } else { "a" };
+        joints.push_str(&format!(
+            "{id},{},{},{},{},{}\n",
+            c[7], c[8], c[9], c[10], c[11]
+        ));
+    }
+    let jp = scratch("j8.csv");
+    std::fs::write(&jp, joints).unwrap();
+    let o = run(
+        &[
+            "verify",
+            "--joints",
+            jp.to_str().unwrap(),
+            "--path",
+            path.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("id `a` appears twice (lines 2 and 3)"),
+        "{}",
+        stderr(&o)
+    );
+}
