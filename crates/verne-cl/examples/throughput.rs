@@ -12,7 +12,7 @@ use verne_cl::{Options, Reader, Units};
 
 #[path = "../tests/common/counting_alloc.rs"]
 mod counting_alloc;
-use counting_alloc::{Counting, allocations};
+use counting_alloc::{Counting, allocations, count_this_thread};
 
 #[global_allocator]
 static A: Counting = Counting;
@@ -113,6 +113,7 @@ fn long_records(scale: usize) -> (f64, f64) {
 }
 
 fn main() {
+    count_this_thread();
     let rows: usize = std::env::args()
         .nth(1)
         .map_or(1_000_000, |s| s.parse().unwrap());
