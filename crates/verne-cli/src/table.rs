@@ -84,8 +84,10 @@ impl CsvSource {
     }
 
     fn check_duplicate_headers(&self) -> Result<(), VerneError> {
-        for (i, h) in self.headers.iter().enumerate() {
-            if self.headers.iter().take(i).any(|o| o == h) {
+        // A set, not a pairwise comparison: a header of 100,000 names is checked at once.
+        let mut seen = std::collections::HashSet::with_capacity(self.headers.len());
+        for h in self.headers.iter() {
+            if !seen.insert(h) {
                 return Err(VerneError::input(
                     &self.name,
                     Some(1),
@@ -470,10 +472,26 @@ pub fn open_input_file(path: &Path) -> io::Result<File> {
     Ok(f)
 }
 
-/// Reads a whole input file, remembered as [`open_input_file`] does.
+/// The largest machine file read (a complete one is a few kB).
+pub const MAX_INPUT_FILE_BYTES: u64 = 16 << 20;
+
+/// Reads a whole input file (a machine file), remembered as [`open_input_file`] does; a file
+/// larger than [`MAX_INPUT_FILE_BYTES`] (or endless, `/dev/zero`) is an error, not a read until
+/// memory runs out.
 pub fn read_input_file(path: &Path) -> io::Result<Vec<u8>> {
     let mut bytes = Vec::new();
-    open_input_file(path)?.read_to_end(&mut bytes)?;
+    open_input_file(path)?
+        .take(MAX_INPUT_FILE_BYTES + 1)
+        .read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > MAX_INPUT_FILE_BYTES {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidData,
+            format!(
+                "larger than {} MiB: expected a machine file (TOML or key,value CSV)",
+                MAX_INPUT_FILE_BYTES >> 20
+            ),
+        ));
+    }
     Ok(bytes)
 }
 
@@ -579,13 +597,22 @@ pub fn format_number(out: &mut Vec<u8>, v: f64, decimals: Option<usize>) {
 /// LF (inside quotes they are data and pass through). The csv crate counts lines by LF only,
 /// one too few after each CRLF record and none in a CR-only file; after this, its line numbers
 /// are the file's. Text without CR or quotes passes through untouched (one memchr2 per read).
+///
+/// It also bounds memory: a line longer than [`MAX_LINE_BYTES`] (`/dev/zero`, a binary file) is
+/// an error naming the line, before the csv crate would buffer all of it.
 pub struct LfLines<R> {
     inner: R,
     /// Inside a quoted field (an escaped `""` toggles twice).
     quoted: bool,
     /// The last byte was a CR turned into LF: an LF right after it belongs to it.
     after_cr: bool,
+    /// Bytes of the current line so far, and its 1-based number.
+    line_bytes: usize,
+    line: u64,
 }
+
+/// The longest line of CSV text read (a header or a row of numbers is far shorter).
+pub const MAX_LINE_BYTES: usize = 16 << 20;
 
 impl<R: Read> LfLines<R> {
     pub fn new(inner: R) -> LfLines<R> {
@@ -593,6 +620,8 @@ impl<R: Read> LfLines<R> {
             inner,
             quoted: false,
             after_cr: false,
+            line_bytes: 0,
+            line: 1,
         }
     }
 
@@ -650,6 +679,24 @@ impl<R: Read> Read for LfLines<R> {
                 return Ok(0);
             }
             let w = self.convert(&mut out[..n]);
+            let text = &out[..w];
+            match memchr::memrchr(b'\n', text) {
+                None => self.line_bytes += w,
+                Some(k) => {
+                    self.line += memchr::memchr_iter(b'\n', text).count() as u64;
+                    self.line_bytes = w - k - 1;
+                }
+            }
+            if self.line_bytes > MAX_LINE_BYTES {
+                return Err(io::Error::new(
+                    io::ErrorKind::InvalidData,
+                    format!(
+                        "line {} is longer than {} MiB: expected CSV text (a header, then rows of numbers)",
+                        self.line,
+                        MAX_LINE_BYTES >> 20
+                    ),
+                ));
+            }
             if w > 0 {
                 return Ok(w);
             }

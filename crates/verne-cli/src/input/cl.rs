@@ -83,13 +83,28 @@ pub fn open_path_input(
             &name,
         )?));
     }
-    stdin
+    (&mut stdin)
+        .take(MAX_STDIN_CL_BYTES + 1)
         .read_to_end(&mut head)
         .map_err(|e| VerneError::io(&name, e))?;
+    if head.len() as u64 > MAX_STDIN_CL_BYTES {
+        return Err(VerneError::input(
+            &name,
+            None,
+            None,
+            format!(
+                "a CL file on stdin is held in memory and this one is larger than {} MiB: give it by name (verne ik FILE): a file is streamed, not held",
+                MAX_STDIN_CL_BYTES >> 20
+            ),
+        ));
+    }
     let input: Box<dyn SeekableInput> = Box::new(std::io::Cursor::new(head));
     let reader = Reader::new(input, options).map_err(|e| cl_error(&name, &e))?;
     Ok(PathInput::Cl(Box::new(reader), name))
 }
+
+/// The largest CL file read from stdin (held in memory for the units look-ahead).
+pub const MAX_STDIN_CL_BYTES: u64 = 256 << 20;
 
 fn open_cl_file(path: &Path, name: &str, options: Options) -> Result<PathInput, VerneError> {
     let f = crate::table::open_input_file(path).map_err(|e| VerneError::io(name, e))?;

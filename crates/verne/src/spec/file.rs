@@ -4,6 +4,8 @@
 //! stops at the first problem: every missing, unknown, mistyped or out-of-range key is reported,
 //! each with the line it is on.
 
+use std::collections::{HashMap, HashSet};
+
 use super::{Limits, Machine, ModuleGeometry, TableGeometry};
 use crate::error::{MachineError, Problem};
 
@@ -190,12 +192,13 @@ impl Machine {
         };
         let mut entries = Vec::new();
         let mut problems = Vec::new();
+        let lines = TomlLines::new(text);
         for (k, v) in &table {
             match v {
                 toml::Value::Table(section) => {
                     for (kk, vv) in section {
                         let key = format!("{k}.{kk}");
-                        let line = find_toml_line(text, k, kk);
+                        let line = lines.get(k, kk);
                         entries.push(Entry {
                             key,
                             value: toml_value(vv),
@@ -206,11 +209,11 @@ impl Machine {
                 other => entries.push(Entry {
                     key: k.clone(),
                     value: toml_value(other),
-                    line: find_toml_line(text, "", k),
+                    line: lines.get("", k),
                 }),
             }
         }
-        problems.extend(check_sections(&table, text));
+        problems.extend(check_sections(&table, &lines));
         finish(entries, problems, source)
     }
 
@@ -407,14 +410,14 @@ fn toml_value(v: &toml::Value) -> Value {
 }
 
 /// Sections that are not tables, or unknown sections, are reported once.
-fn check_sections(table: &toml::Table, text: &str) -> Vec<Problem> {
+fn check_sections(table: &toml::Table, lines: &TomlLines) -> Vec<Problem> {
     let mut out = Vec::new();
     for section in ["module", "limits", "table", "tool", "verify"] {
         if let Some(v) = table.get(section)
             && !v.is_table()
         {
             out.push(Problem {
-                line: find_toml_line(text, "", section),
+                line: lines.get("", section),
                 key: section.to_string(),
                 message: format!("expected a [{section}] table"),
             });
@@ -423,23 +426,33 @@ fn check_sections(table: &toml::Table, text: &str) -> Vec<Problem> {
     out
 }
 
-/// The 1-based line of `key` inside `[section]` (or at top level when `section` is empty).
-fn find_toml_line(text: &str, section: &str, key: &str) -> Option<usize> {
-    let mut current = String::new();
-    for (i, line) in text.lines().enumerate() {
-        let t = line.trim();
-        if let Some(rest) = t.strip_prefix('[') {
-            current = rest.trim_end_matches(']').trim().to_string();
-            continue;
-        }
-        if current == section {
-            let lhs = t.split('=').next().unwrap_or("").trim().trim_matches('"');
-            if lhs == key && t.contains('=') {
-                return Some(i + 1);
+/// The 1-based line of every `key = ...` of a TOML text by (section, key), the first when a key
+/// repeats: one pass over the text, so that a file of many keys is indexed in linear time.
+struct TomlLines(HashMap<(String, String), usize>);
+
+impl TomlLines {
+    fn new(text: &str) -> TomlLines {
+        let mut map = HashMap::new();
+        let mut current = String::new();
+        for (i, line) in text.lines().enumerate() {
+            let t = line.trim();
+            if let Some(rest) = t.strip_prefix('[') {
+                current = rest.trim_end_matches(']').trim().to_string();
+                continue;
+            }
+            if t.contains('=') {
+                let lhs = t.split('=').next().unwrap_or("").trim().trim_matches('"');
+                map.entry((current.clone(), lhs.to_string()))
+                    .or_insert(i + 1);
             }
         }
+        TomlLines(map)
     }
-    None
+
+    /// The line of `key` inside `[section]` (or at top level when `section` is empty).
+    fn get(&self, section: &str, key: &str) -> Option<usize> {
+        self.0.get(&(section.to_string(), key.to_string())).copied()
+    }
 }
 
 fn finish(
@@ -453,8 +466,9 @@ fn finish(
     let mut verify = Vec::new();
     let mut name = String::from("unnamed");
     // Unknown and duplicated keys.
-    for (idx, e) in entries.iter().enumerate() {
-        if entries[..idx].iter().any(|p| p.key == e.key) {
+    let mut seen = HashSet::with_capacity(entries.len());
+    for e in &entries {
+        if !seen.insert(e.key.as_str()) {
             problems.push(Problem {
                 line: e.line,
                 key: e.key.clone(),
