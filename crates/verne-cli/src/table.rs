@@ -87,13 +87,14 @@ impl CsvSource {
         // A set, not a pairwise comparison: a header of 100,000 names is checked at once.
         let mut seen = std::collections::HashSet::with_capacity(self.headers.len());
         for h in self.headers.iter() {
-            if !seen.insert(h) {
+            // Names are matched ignoring case, so `x` and `X` are the same column.
+            if !seen.insert(h.to_ascii_lowercase()) {
                 return Err(VerneError::input(
                     &self.name,
                     Some(1),
                     Some(&shown(h)),
                     format!(
-                        "column `{}` appears twice in the header; expected unique column names",
+                        "column `{}` appears twice in the header (names are matched ignoring case); expected unique column names",
                         shown(h)
                     ),
                 ));
@@ -121,9 +122,11 @@ impl CsvSource {
         &self.headers
     }
 
-    /// Index of a column by exact name.
+    /// Index of a column by name, ignoring ASCII case (`X,Y,Z,I,J,K` as CAM exports write it).
     pub fn column(&self, name: &str) -> Option<usize> {
-        self.headers.iter().position(|h| h == name.as_bytes())
+        self.headers
+            .iter()
+            .position(|h| h.eq_ignore_ascii_case(name.as_bytes()))
     }
 
     /// Indices of the required columns, or an error naming the missing ones and the header found.
@@ -141,7 +144,7 @@ impl CsvSource {
             Some(1),
             None,
             format!(
-                "missing column{} {}; expected a header with {}, found `{}`{}",
+                "missing column{} {}; expected a header with {}, found `{}`{}{INPUT_SHAPES}",
                 if missing.len() > 1 { "s" } else { "" },
                 missing
                     .iter()
@@ -703,6 +706,9 @@ impl<R: Read> Read for LfLines<R> {
         }
     }
 }
+
+/// Appended to a missing-columns message: the input shapes verne reads (docs/csv.md).
+const INPUT_SHAPES: &str = ". Inputs verne reads (column names in any case): tool poses x,y,z with i,j,k or phi1,phi2; platform points xp,yp,zp; machine joints rho1,rho2,rho3,theta1,theta2; slider rows rho1,rho2,rho3";
 
 /// The line a record comes from: the value of `line_column` when the rows come from another
 /// file (a CL file read as CSV), else the record's line in the CSV text.

@@ -38,13 +38,13 @@ const CSV_CASES: &[(&str, i32, &str, usize)] = &[
     (
         "missing_column.csv",
         2,
-        "verne: error: tests/data/hostile/missing_column.csv:1: missing column `zp`; expected a header with xp,yp,zp, found `xp,yp`",
+        "verne: error: tests/data/hostile/missing_column.csv:1: missing column `zp`; expected a header with xp,yp,zp, found `xp,yp`. Inputs verne reads (column names in any case): tool poses x,y,z with i,j,k or phi1,phi2; platform points xp,yp,zp; machine joints rho1,rho2,rho3,theta1,theta2; slider rows rho1,rho2,rho3",
         0,
     ),
     (
         "duplicated_column.csv",
         2,
-        "verne: error: tests/data/hostile/duplicated_column.csv:1: column yp: column `yp` appears twice in the header; expected unique column names",
+        "verne: error: tests/data/hostile/duplicated_column.csv:1: column yp: column `yp` appears twice in the header (names are matched ignoring case); expected unique column names",
         0,
     ),
     (
@@ -80,7 +80,7 @@ const CSV_CASES: &[(&str, i32, &str, usize)] = &[
     (
         "semicolons.csv",
         2,
-        "verne: error: tests/data/hostile/semicolons.csv:1: missing columns `xp`, `yp`, `zp`; expected a header with xp,yp,zp, found `xp;yp;zp` (the file looks separated by `;`; verne reads comma-separated values)",
+        "verne: error: tests/data/hostile/semicolons.csv:1: missing columns `xp`, `yp`, `zp`; expected a header with xp,yp,zp, found `xp;yp;zp` (the file looks separated by `;`; verne reads comma-separated values). Inputs verne reads (column names in any case): tool poses x,y,z with i,j,k or phi1,phi2; platform points xp,yp,zp; machine joints rho1,rho2,rho3,theta1,theta2; slider rows rho1,rho2,rho3",
         0,
     ),
     (

@@ -328,3 +328,26 @@ fn many_keys_and_many_columns_are_read_correctly() {
     assert_eq!(header.len(), 3 + 120_000 + 5);
     assert_eq!(header[120_002], "c119999");
 }
+
+/// The newcomer's headers: `X,Y,Z,I,J,K` as CAM exports write them give the same joints as the
+/// lower-case header; `x` and `X` together are a duplicate; a missing column names the input
+/// shapes.
+#[test]
+fn headers_match_ignoring_case() {
+    let lower = run(&["ik"], Some("x,y,z,i,j,k\n10,-20,80,0,0,1\n"));
+    let upper = run(&["ik"], Some("X,Y,Z,I,J,K\n10,-20,80,0,0,1\n"));
+    assert_eq!(upper.status.code(), Some(0), "{}", stderr(&upper));
+    let body = |o: &std::process::Output| {
+        String::from_utf8_lossy(&o.stdout)
+            .lines()
+            .nth(1)
+            .unwrap()
+            .to_string()
+    };
+    assert_eq!(body(&lower), body(&upper));
+    let dup = run(&["ik"], Some("x,X,y,z\n1,1,1,1\n"));
+    assert_eq!(dup.status.code(), Some(2));
+    assert!(stderr(&dup).contains("appears twice in the header (names are matched ignoring case)"));
+    let missing = run(&["ik"], Some("a,b\n1,2\n"));
+    assert!(stderr(&missing).contains("tool poses x,y,z with i,j,k or phi1,phi2"));
+}

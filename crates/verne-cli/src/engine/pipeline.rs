@@ -308,7 +308,10 @@ pub fn run<J: RowJob>(
         }
     } else {
         for (i, h) in source.headers().iter().enumerate() {
-            match outputs.iter().position(|o| o.as_bytes() == h) {
+            match outputs
+                .iter()
+                .position(|o| o.as_bytes().eq_ignore_ascii_case(h))
+            {
                 Some(k) => slots.push(Slot::Computed(k)),
                 None => slots.push(Slot::Input(i)),
             }
