@@ -23,14 +23,16 @@ pub struct Cli {
 
 #[derive(Debug, Subcommand)]
 pub enum Command {
-    /// Inverse kinematics: platform points (xp,yp,zp) -> joints (alpha, rho1, rho2, rho3).
+    /// Inverse kinematics: a toolpath (CL file, or CSV of tool tip + axis) -> the five machine
+    /// joints; or platform points (xp,yp,zp) -> the parallel module's sliders.
     #[command(
-        after_help = "Example:\n  verne ik data/path.csv -o joints.csv\n  verne ik --all --radians --pose=-240,-86,1000\n\nInput columns: xp,yp,zp (mm). Output adds alpha,rho1,rho2,rho3,status\n(--all: branch,alpha,rho1,rho2,rho3,s1,s2,s3,working,status).\n\nExit codes: 0 all rows ok, 1 some row not ok, 2 fatal."
+        after_help = "Examples:\n  verne ik data/example.cl -o joints.csv          a CAM job: CL file -> rho1,rho2,rho3,theta1,theta2\n  verne ik --tool 10,-20,80,0,0,1                  one tool pose X,Y,Z,I,J,K\n  verne ik data/platform_path.csv                  platform points xp,yp,zp (the parallel module)\n  verne ik --all --radians --pose=-240,-86,1000    every branch of one platform point\n\nInputs: a CL file (APT, NX CLSF, Creo, CATIA, SolidWorks CAM); a CSV of tool poses x,y,z with\ni,j,k or phi1,phi2 (workpiece frame; output adds rho1,rho2,rho3,theta1,theta2,orientation,\nflags,status); a CSV of platform points xp,yp,zp (output adds alpha,rho1,rho2,rho3,status).\nColumn names in any case. --all: one row per real branch.\n\nExit codes: 0 all rows ok, 1 some row not ok, 2 fatal."
     )]
     Ik(IkArgs),
-    /// Forward kinematics: joints (rho1,rho2,rho3) -> platform pose (xp, yp, zp, alpha).
+    /// Forward kinematics: machine joints (rho1,rho2,rho3,theta1,theta2) -> tool tip and axis; or
+    /// sliders (rho1,rho2,rho3) -> the platform pose (xp, yp, zp, alpha).
     #[command(
-        after_help = "Example:\n  verne fk joints.csv\n  verne fk --all --radians --joints 674,685,250\n  verne ik path.csv | verne fk\n\nInput columns: rho1,rho2,rho3 (mm). Output adds xp,yp,zp,alpha,status\n(--all: branch,xp,yp,zp,alpha,s1,s2,s3,working,status).\n\nExit codes: 0 all rows ok, 1 some row not ok, 2 fatal."
+        after_help = "Examples:\n  verne ik data/example.cl | verne fk              the tool poses back from the joints\n  verne fk --machine-joints 314.12,260.78,260.60,0,0  one row of machine joints\n  verne fk --all --radians --joints 674,685,250    every assembly mode of three sliders\n\nInputs: machine joints rho1,rho2,rho3 (mm), theta1,theta2 (output adds x,y,z,i,j,k,phi1,phi2,\nstatus); slider rows rho1,rho2,rho3 (output adds xp,yp,zp,alpha,status). --all: one row per\nreal assembly mode.\n\nExit codes: 0 all rows ok, 1 some row not ok, 2 fatal."
     )]
     Fk(FkArgs),
     /// Every branch of one query, with its verdict, as a table for a person (or --csv).

@@ -309,3 +309,34 @@ fn modes_plot_draws_every_branch() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The examples in `verne ik --help`, `verne fk --help` and `verne modes --help` run: each
+/// `verne ...` line (up to the two spaces before its note) runs from the repository root,
+/// through `sh` for pipes, and does not fail with a fatal error (exit 2).
+#[test]
+fn help_examples_run() {
+    let dir = std::env::temp_dir().join(format!("verne-help-examples-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut ran = 0;
+    for sub in ["ik", "fk", "modes"] {
+        let help = String::from_utf8(run(&[sub, "--help"], None).stdout).unwrap();
+        for line in help.lines().filter(|l| l.starts_with("  verne ")) {
+            let cmd = line.trim().split("  ").next().unwrap();
+            let cmd = cmd
+                .replace("verne ", &format!("{} ", common::BIN))
+                .replace("-o joints.csv", &format!("-o {}/joints.csv", dir.display()));
+            let out = std::process::Command::new("sh")
+                .args(["-c", &cmd])
+                .current_dir(common::ROOT)
+                .output()
+                .unwrap();
+            assert!(
+                matches!(out.status.code(), Some(0 | 1)),
+                "`{line}` in `verne {sub} --help`: {}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+            ran += 1;
+        }
+    }
+    assert!(ran >= 8, "{ran} examples");
+}
