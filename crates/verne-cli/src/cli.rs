@@ -26,7 +26,7 @@ pub enum Command {
     /// Inverse kinematics: a toolpath (CL file, or CSV of tool tip + axis) -> the five machine
     /// joints; or platform points (xp,yp,zp) -> the parallel module's sliders.
     #[command(
-        after_help = "Examples:\n  verne ik data/example.cl -o joints.csv          a CAM job: CL file -> rho1,rho2,rho3,theta1,theta2\n  verne ik --tool 10,-20,80,0,0,1                  one tool pose X,Y,Z,I,J,K\n  verne ik data/platform_path.csv                  platform points xp,yp,zp (the parallel module)\n  verne ik --all --radians --pose=-240,-86,1000    every branch of one platform point\n\nInputs: a CL file (APT, NX CLSF, Creo, CATIA, SolidWorks CAM); a CSV of tool poses x,y,z with\ni,j,k or phi1,phi2 (workpiece frame; output adds rho1,rho2,rho3,theta1,theta2,orientation,\nflags,status); a CSV of platform points xp,yp,zp (output adds alpha,rho1,rho2,rho3,status).\nColumn names in any case. --all: one row per real branch.\n\nExit codes: 0 all rows ok, 1 some row not ok, 2 fatal."
+        after_help = "Examples:\n  verne ik data/example.cl -o joints.csv          a CAM job: CL file -> rho1,rho2,rho3,theta1,theta2\n  verne ik data/example-tcp.ngc --format gcode     a tool-centre program -> a joint program\n  verne ik --tool 10,-20,80,0,0,1                  one tool pose X,Y,Z,I,J,K\n  verne ik data/platform_path.csv                  platform points xp,yp,zp (the parallel module)\n  verne ik --all --radians --pose=-240,-86,1000    every branch of one platform point\n\nInputs: a CL file (APT, NX CLSF, Creo, CATIA, SolidWorks CAM); a tool-centre G-code program\n(X Y Z and, by the machine file's [gcode] table, A C = phi1 phi2 or I J K); a CSV of tool\nposes x,y,z with i,j,k or phi1,phi2 (workpiece frame; output adds rho1,rho2,rho3,theta1,theta2,\norientation,flags,status); a CSV of platform points xp,yp,zp (output adds alpha,rho1,rho2,rho3,\nstatus). Column names in any case. --all: one row per real branch.\n\nExit codes: 0 all rows ok, 1 some row not ok, 2 fatal."
     )]
     Ik(IkArgs),
     /// Forward kinematics: machine joints (rho1,rho2,rho3,theta1,theta2) -> tool tip and axis; or
@@ -94,12 +94,13 @@ pub struct CommonArgs {
 #[derive(Debug, Args)]
 pub struct IkArgs {
     /// Input: a CSV of tool poses (x,y,z with i,j,k or phi1,phi2; workpiece frame), a CSV of
-    /// platform points (xp,yp,zp), or a CL file (APT, NX CLSF, Creo, CATIA, SolidWorks CAM);
+    /// platform points (xp,yp,zp), a CL file (APT, NX CLSF, Creo, CATIA, SolidWorks CAM), or a
+    /// tool-centre G-code program (X Y Z and the [gcode] orientation words of the machine file);
     /// absent or `-` reads stdin.
     #[arg(value_name = "INPUT")]
     pub input: Option<PathBuf>,
-    /// How to read INPUT (default: `apt` for a CL file, known by its extension or its first
-    /// record, else `csv`).
+    /// How to read INPUT (default: `apt` for a CL file, `gcode` for a G-code program, known by
+    /// the extension or the first record or block, else `csv`).
     #[arg(long, value_enum, value_name = "FORMAT")]
     pub input_format: Option<InputFormat>,
     /// One platform point XP,YP,ZP instead of an input file (repeatable). Use
@@ -116,7 +117,8 @@ pub struct IkArgs {
     /// On the first row of a path, which orientation solution to take when both are feasible.
     #[arg(long, value_enum, default_value = "smallest-theta1")]
     pub prefer: Prefer,
-    /// Output format: CSV, or a space-separated joint list for LinuxCNC's halstreamer.
+    /// Output format: CSV, a space-separated joint list for LinuxCNC's halstreamer, or a G-code
+    /// joint program (`verne verify --joints` reads it back).
     #[arg(long, value_enum, default_value = "csv")]
     pub format: OutputFormat,
     /// Output CSV (written atomically); absent or `-` writes stdout.
@@ -191,15 +193,18 @@ pub enum MachineCommand {
 }
 
 pub use crate::arg_values::*;
+use crate::input::cl::ReadOptions;
 
 /// How a toolpath is read and where the part sits (`verne ik`, `verne verify --path`).
 #[derive(Debug, Clone, Args)]
 pub struct PartArgs {
-    /// Units of a CL file. Default: what the file says (UNITS, else its feed words IPM/MMPM,
-    /// else mm with a warning); given, a UNITS record that says otherwise is an error.
+    /// Units of a CL file or G-code program. Default: what the file says (UNITS, else its feed
+    /// words IPM/MMPM; G20/G21), else mm with a warning; given, a file that says otherwise is an
+    /// error.
     #[arg(long, value_enum, value_name = "UNITS")]
     pub units: Option<ClUnits>,
-    /// Chordal tolerance (mm) of the points interpolated on a CL file's CIRCLE arcs.
+    /// Chordal tolerance (mm) of the points interpolated on arcs (a CL file's CIRCLE, G-code's
+    /// G2/G3).
     #[arg(long = "chord-tol", value_name = "MM", value_parser = crate::arg_values::parse_positive, default_value_t = verne_cl::DEFAULT_CHORD_TOL_MM)]
     pub chord_tol: f64,
     /// Where the part sits on the table: X,Y,Z (mm) added to every tool tip read (CAM's part
@@ -218,6 +223,19 @@ impl PartArgs {
                 ClUnits::In => verne_cl::Units::Inch,
             }),
             ..verne_cl::Options::default()
+        }
+    }
+
+    /// How toolpaths are read: CL files, and G-code with the machine's `[gcode]` words.
+    pub fn read_options(&self, words: &verne::spec::gcode::GcodeWords) -> ReadOptions {
+        let units = self.units.map(|u| match u {
+            ClUnits::Mm => verne_gcode::Units::Mm,
+            ClUnits::In => verne_gcode::Units::Inch,
+        });
+        ReadOptions {
+            cl: self.cl_options(),
+            gcode: crate::input::gcode::options(self.chord_tol, units, words),
+            words: *words,
         }
     }
 
@@ -241,7 +259,10 @@ pub enum ClUnits {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum InputFormat {
     Csv,
+    /// A CL file (APT source and the CAM systems' dialects).
     Apt,
+    /// A G-code program (RS274/NGC).
+    Gcode,
 }
 
 /// First-row orientation choice along a path.
@@ -261,6 +282,9 @@ pub enum OutputFormat {
     Csv,
     /// rho1 rho2 rho3 theta1 theta2 per line, no header (LinuxCNC halstreamer).
     Halstreamer,
+    /// A joint program: one G-code block per pose, the joints by the machine file's [gcode]
+    /// letters, feed moves in inverse time (G93) at the path's feed.
+    Gcode,
 }
 
 #[derive(Debug, Args)]
@@ -356,12 +380,13 @@ pub enum VerifyFormat {
 #[derive(Debug, Args)]
 pub struct VerifyArgs {
     /// Joint table (CSV): rho1,rho2,rho3 (mm), theta1,theta2 (degrees); optional id, t (s) or
-    /// feed (mm/min).
-    #[arg(long, value_name = "POST.csv")]
+    /// feed (mm/min), motion; or a G-code joint program (the letters of the machine file's
+    /// [gcode] table; U V W A C by default), its feeds timing the moves.
+    #[arg(long, value_name = "POST.csv|ngc")]
     pub joints: PathBuf,
-    /// Intended path: CSV with x,y,z and i,j,k or phi1,phi2 (degrees), optional id; or a CL
-    /// file (APT, NX CLSF, Creo, CATIA, SolidWorks CAM).
-    #[arg(long, value_name = "INTENDED.csv|cl")]
+    /// Intended path: CSV with x,y,z and i,j,k or phi1,phi2 (degrees), optional id; a CL
+    /// file (APT, NX CLSF, Creo, CATIA, SolidWorks CAM); or a tool-centre G-code program.
+    #[arg(long, value_name = "INTENDED.csv|cl|ngc")]
     pub path: PathBuf,
     #[command(flatten)]
     pub part: PartArgs,

@@ -32,6 +32,7 @@ pub mod error;
 pub mod fuzz_entry;
 pub mod input;
 pub mod plot;
+pub mod post;
 pub mod report;
 pub mod table;
 

@@ -327,6 +327,13 @@ impl Sink {
         }
     }
 
+    /// Passes everything written through `wrap` (a writer that turns the CSV into another
+    /// format, such as [`crate::post::GcodePost`]); call before the first write.
+    pub fn wrap(&mut self, wrap: impl FnOnce(Box<dyn Write + Send>) -> Box<dyn Write + Send>) {
+        let inner = std::mem::replace(&mut self.writer, Box::new(io::sink()));
+        self.writer = wrap(inner);
+    }
+
     /// The field delimiter of the records this sink writes.
     pub fn delimiter(&self) -> u8 {
         self.delimiter

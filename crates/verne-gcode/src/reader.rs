@@ -219,7 +219,9 @@ impl<R: BufRead> Reader<R> {
             if n == 0 {
                 return Ok(());
             }
-            if sink.last() == Some(&b'\n') || sink.len() <= self.options.max_line_bytes {
+            // Blank lines and the closing `%` are not program text.
+            let t = sink.trim_ascii();
+            if !t.is_empty() && t != b"%" {
                 self.summary.lines_after_end += 1;
             }
         }

@@ -44,8 +44,8 @@ fn straight_moves_modes_units_and_feeds() {
     assert!((rows[6].duration_s.unwrap() - 60.0 * 12.0 / 254.0).abs() < 1e-12);
     assert_eq!(s.end_line, Some(11));
     assert_eq!(
-        s.lines_after_end, 2,
-        "the closing % and the line after it are not read"
+        s.lines_after_end, 1,
+        "the line after the closing % is not read"
     );
     assert_eq!(s.units, Units::Inch);
     assert_eq!(s.axes_used_letters(), "XYZAC");

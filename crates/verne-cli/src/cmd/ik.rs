@@ -8,8 +8,9 @@ use crate::table::CsvSource;
 use verne::machine::FirstRowChoice;
 
 use super::{inline_source, load_machine, run_rows, units};
-use crate::cli::{IkArgs, InputFormat, OutputFormat, Prefer};
-use crate::input::cl::{ClAsCsv, PathInput, open_path_input, report_summary};
+use crate::cli::{IkArgs, OutputFormat, Prefer};
+use crate::input::cl::{ClAsCsv, ClRows, PathInput, open_path_input, report_summary};
+use crate::input::gcode::{TcpAsCsv, TcpRows};
 
 pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
     if let Some(spec) = super::glider::load(args.common.machine.as_deref())? {
@@ -18,14 +19,23 @@ pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
     let machine = load_machine(args.common.machine.as_deref())?;
     let mut u = units(&args.common);
     u.halstreamer = args.format == OutputFormat::Halstreamer;
-    if u.halstreamer && args.all {
-        return Err(VerneError::Usage(
-            "--format halstreamer writes one joint row per pose; it cannot be combined with --all"
-                .into(),
-        ));
+    if args.format == OutputFormat::Gcode {
+        if args.common.radians || args.common.precision.is_some() {
+            return Err(VerneError::Usage(
+                "--format gcode writes degrees and mm with its own precision: drop --radians and --precision".into(),
+            ));
+        }
+        u.gcode = Some(machine.gcode);
+    }
+    let format_name = if u.halstreamer { "halstreamer" } else { "gcode" };
+    if u.every_row_needed() && args.all {
+        return Err(VerneError::Usage(format!(
+            "--format {format_name} writes one joint row per pose; it cannot be combined with --all"
+        )));
     }
     let tool_length = args.tool_length.unwrap_or(machine.tool_length);
     let mut cl_summary = None;
+    let mut gcode_summary = None;
     let source = if !args.pose.is_empty() {
         inline_source(
             "xp,yp,zp",
@@ -37,13 +47,20 @@ pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
             &args.tool.iter().map(|p| p.to_vec()).collect::<Vec<_>>(),
         )?
     } else {
-        let force = args.input_format.map(|f| f == InputFormat::Apt);
-        match open_path_input(args.input.as_deref(), force, args.part.cl_options())? {
+        let options = args.part.read_options(&machine.gcode);
+        match open_path_input(args.input.as_deref(), args.input_format, &options)? {
             PathInput::Csv(src) => src,
+            PathInput::Gcode(reader, name) => {
+                let rows = TcpRows::new(*reader, &name, &machine.gcode);
+                gcode_summary = Some((rows.summary(), name.clone()));
+                CsvSource::from_reader(Box::new(TcpAsCsv::new(rows)), &name)?
+                    .with_line_column("line")
+            }
             PathInput::Cl(reader, name) => {
-                let adapter = ClAsCsv::new(*reader);
-                cl_summary = Some((adapter.summary(), name.clone()));
-                CsvSource::from_reader(Box::new(adapter), &name)?.with_line_column("line")
+                let rows = ClRows::new(*reader);
+                cl_summary = Some((rows.summary(), name.clone()));
+                CsvSource::from_reader(Box::new(ClAsCsv::new(rows)), &name)?
+                    .with_line_column("line")
             }
         }
     };
@@ -78,8 +95,8 @@ pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
                     "--offset places tool poses (x,y,z): platform points (xp,yp,zp) are already in the machine's frame".into(),
                 ));
             }
-            if u.halstreamer {
-                return Err(VerneError::Usage("--format halstreamer writes machine joints: give tool poses (x,y,z with i,j,k or phi1,phi2), not platform points".into()));
+            if u.every_row_needed() {
+                return Err(VerneError::Usage(format!("--format {format_name} writes machine joints: give tool poses (x,y,z with i,j,k or phi1,phi2), not platform points")));
             }
             let output = args.output.as_ref();
             if args.all {
@@ -93,6 +110,11 @@ pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
         && let Ok(s) = summary.lock()
     {
         report_summary("ik", &name, &s, tool_length);
+    }
+    if let Some((summary, name)) = gcode_summary
+        && let Ok(s) = summary.lock()
+    {
+        crate::input::gcode::report_summary("ik", &name, &s);
     }
     Ok(code)
 }

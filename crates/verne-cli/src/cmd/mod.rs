@@ -56,6 +56,7 @@ pub fn units(common: &CommonArgs) -> Units {
         radians: common.radians,
         decimals: common.precision.map(usize::from),
         halstreamer: false,
+        gcode: None,
     }
 }
 
@@ -84,6 +85,10 @@ pub fn run_rows<J: RowJob>(
 ) -> Result<u8, VerneError> {
     let delimiter = if units.halstreamer { b' ' } else { b',' };
     let mut sink = Sink::create_delimited(output.map(PathBuf::as_path), delimiter)?;
+    if let Some(words) = units.gcode {
+        let name = source.name().to_string();
+        sink.wrap(|out| Box::new(crate::post::GcodePost::new(out, words, &name)));
+    }
     let bar = progress_bar();
     let tick = |n: u64| {
         if let Some(b) = &bar {

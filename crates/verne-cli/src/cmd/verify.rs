@@ -2,9 +2,9 @@
 //! Opens the files, writes the report CSV atomically, prints the summary, picks the exit code.
 
 use crate::error::VerneError;
-use crate::input::verify_files::{JointReader, PathReader};
+use crate::input::verify_files::{JointInput, PathReader};
 use crate::report::verify::{short_number, summary_json, summary_text};
-use crate::table::{CsvSource, Sink};
+use crate::table::Sink;
 use csv::ByteRecord;
 use verne::verify::{Thresholds, VerifyOptions, verify};
 
@@ -31,8 +31,9 @@ pub fn run(args: &VerifyArgs) -> Result<u8, VerneError> {
         thresholds,
         tool_length: args.tool_length.unwrap_or(machine.tool_length),
     };
-    let mut joints = JointReader::new(CsvSource::open(Some(&args.joints))?)?;
-    let mut path = PathReader::open(&args.path, args.part.cl_options(), args.part.offset())?;
+    let options = args.part.read_options(&machine.gcode);
+    let mut joints = JointInput::open(&args.joints, &options)?;
+    let mut path = PathReader::open(&args.path, &options, args.part.offset())?;
     let mut sink = match &args.report {
         Some(p) => {
             let mut s = Sink::create(Some(p))?;
@@ -71,6 +72,12 @@ pub fn run(args: &VerifyArgs) -> Result<u8, VerneError> {
     }
     if let Some((name, s)) = path.cl_summary() {
         crate::input::cl::report_summary("verify", name, s, opt.tool_length);
+    }
+    if let Some((name, s)) = path.gcode_summary() {
+        crate::input::gcode::report_summary("verify", name, &s);
+    }
+    if let Some((name, s)) = joints.gcode_summary() {
+        crate::input::gcode::report_summary("verify", name, s);
     }
     say!(
         "verne verify: {} against {}: {}",

@@ -52,6 +52,16 @@ pub struct Units {
     /// `--format halstreamer`: only the joints [`HALSTREAMER_COLUMNS`], no header, and a row
     /// that is not ok stops the run (a joint list for LinuxCNC's halstreamer cannot skip one).
     pub halstreamer: bool,
+    /// `--format gcode`: the CSV goes through [`crate::post::GcodePost`] with these words, and
+    /// a row that is not ok stops the run (a joint program cannot skip one either).
+    pub gcode: Option<verne::spec::gcode::GcodeWords>,
+}
+
+impl Units {
+    /// A row that is not ok stops the run: the output is a program for the controller.
+    pub fn every_row_needed(&self) -> bool {
+        self.halstreamer || self.gcode.is_some()
+    }
 }
 
 /// The columns of a halstreamer joint list, in order.
@@ -466,13 +476,18 @@ fn process<J: RowJob>(
             scratch.clear();
             write_cell(&mut scratch, outcome.status, plan.units);
             let text = String::from_utf8_lossy(&scratch).into_owned();
-            if plan.units.halstreamer {
+            if plan.units.every_row_needed() {
+                let what = if plan.units.halstreamer {
+                    "a halstreamer joint list"
+                } else {
+                    "a joint program"
+                };
                 return Err(VerneError::input(
                     plan.file,
                     Some(line),
                     None,
                     format!(
-                        "row status `{text}`: a halstreamer joint list cannot leave out a row; fix the path or use CSV output to see every row's status"
+                        "row status `{text}`: {what} cannot leave out a row; fix the path or use CSV output to see every row's status"
                     ),
                 ));
             }

@@ -10,7 +10,10 @@ use std::sync::{Arc, Mutex};
 
 use verne_cl::{ClError, Options, Reader, Summary};
 
+use crate::cli::InputFormat;
 use crate::error::VerneError;
+use crate::input::as_csv::{AsCsv, CsvRows, invalid_data};
+use crate::input::gcode::{GcodeReader, gcode_error};
 use crate::table::CsvSource;
 
 /// A CL error as the CLI's input error: file, line, column, what was expected.
@@ -32,41 +35,80 @@ pub type ClReader = Reader<Box<dyn SeekableInput>>;
 pub enum PathInput {
     /// A CL file, with its name for messages.
     Cl(Box<ClReader>, String),
+    /// A G-code program, with its name.
+    Gcode(Box<GcodeReader>, String),
     /// Anything else: CSV.
     Csv(CsvSource),
 }
 
-/// Opens `path` (or stdin for `None` or `-`) as a CL file or as CSV. `force` (`--input-format`)
-/// decides when given; else a CL extension (`verne_cl::has_cl_extension`) or, failing that,
-/// the first [`verne_cl::SNIFF_BYTES`] bytes (`verne_cl::sniff_content`: a first record such as
-/// `TOOL PATH/`, `PARTNO`, `$$`, `GOTO/`) make it a CL file, so that a CL file is never parsed
-/// as CSV. A CL file on stdin is read into memory (the units look-ahead reads it twice).
+/// How the readers of toolpaths are set up (`--units`, `--chord-tol`, the machine's `[gcode]`).
+#[derive(Debug, Clone, Copy)]
+pub struct ReadOptions {
+    pub cl: Options,
+    pub gcode: verne_gcode::Options,
+    /// What the words of a G-code program mean (the machine file's `[gcode]` table).
+    pub words: verne::spec::gcode::GcodeWords,
+}
+
+/// What a file is, from its name: a CL or G-code extension.
+fn format_by_name(name: &str) -> Option<InputFormat> {
+    if verne_cl::has_cl_extension(name) {
+        Some(InputFormat::Apt)
+    } else if verne_gcode::has_gcode_extension(name) {
+        Some(InputFormat::Gcode)
+    } else {
+        None
+    }
+}
+
+/// What a file is, from its first bytes: a CL record, a G-code block, else CSV.
+fn format_by_content(head: &[u8]) -> InputFormat {
+    if verne_cl::sniff_content(head) {
+        InputFormat::Apt
+    } else if verne_gcode::sniff_content(head) {
+        InputFormat::Gcode
+    } else {
+        InputFormat::Csv
+    }
+}
+
+/// Opens `path` (or stdin for `None` or `-`) as a CL file, a G-code program or CSV. `force`
+/// (`--input-format`) decides when given; else a CL or G-code extension or, failing that, the
+/// first [`verne_cl::SNIFF_BYTES`] bytes (a first record such as `TOOL PATH/`, `PARTNO`, `$$`,
+/// `GOTO/`; a first block such as `%`, `N10 G21`, `G0 X0`), so that neither is ever parsed as
+/// CSV. A CL file on stdin is read into memory (the units look-ahead reads it twice); G-code
+/// and CSV are streamed.
 pub fn open_path_input(
     path: Option<&Path>,
-    force: Option<bool>,
-    options: Options,
+    force: Option<InputFormat>,
+    options: &ReadOptions,
 ) -> Result<PathInput, VerneError> {
     let file = path.filter(|p| p.as_os_str() != "-");
     let name = file.map_or("<stdin>".to_string(), |p| p.display().to_string());
-    let by_name = file.is_some_and(|p| verne_cl::has_cl_extension(&p.to_string_lossy()));
-    if force == Some(false) || (force.is_none() && !by_name && file.is_some()) {
-        // A file without a CL extension: its first bytes decide (unless forced to CSV).
-        if force.is_none()
-            && let Some(p) = file
-        {
-            let mut head = Vec::with_capacity(verne_cl::SNIFF_BYTES);
-            let f = crate::table::open_input_file(p).map_err(|e| VerneError::io(&name, e))?;
-            f.take(verne_cl::SNIFF_BYTES as u64)
-                .read_to_end(&mut head)
-                .map_err(|e| VerneError::io(&name, e))?;
-            if verne_cl::sniff_content(&head) {
-                return open_cl_file(p, &name, options);
-            }
-        }
-        return Ok(PathInput::Csv(CsvSource::open(path)?));
-    }
     if let Some(p) = file {
-        return open_cl_file(p, &name, options);
+        let format = match force.or_else(|| format_by_name(&p.to_string_lossy())) {
+            Some(f) => f,
+            None => {
+                let mut head = Vec::with_capacity(verne_cl::SNIFF_BYTES);
+                let f = crate::table::open_input_file(p).map_err(|e| VerneError::io(&name, e))?;
+                f.take(verne_cl::SNIFF_BYTES as u64)
+                    .read_to_end(&mut head)
+                    .map_err(|e| VerneError::io(&name, e))?;
+                format_by_content(&head)
+            }
+        };
+        return match format {
+            InputFormat::Apt => open_cl_file(p, &name, options.cl),
+            InputFormat::Gcode => {
+                let f = crate::table::open_input_file(p).map_err(|e| VerneError::io(&name, e))?;
+                let input: Box<dyn BufRead + Send> =
+                    Box::new(std::io::BufReader::with_capacity(64 * 1024, f));
+                let reader = verne_gcode::Reader::new(input, options.gcode)
+                    .map_err(|e| gcode_error(&name, &e))?;
+                Ok(PathInput::Gcode(Box::new(reader), name))
+            }
+            InputFormat::Csv => Ok(PathInput::Csv(CsvSource::open(path)?)),
+        };
     }
     // Stdin: look at its start, then read on as whichever it is.
     let mut stdin = std::io::stdin().lock();
@@ -75,13 +117,25 @@ pub fn open_path_input(
         .take(verne_cl::SNIFF_BYTES as u64)
         .read_to_end(&mut head)
         .map_err(|e| VerneError::io(&name, e))?;
-    if force.is_none() && !verne_cl::sniff_content(&head) {
-        drop(stdin);
-        let rest = std::io::Cursor::new(head).chain(std::io::stdin());
-        return Ok(PathInput::Csv(CsvSource::from_reader(
-            Box::new(rest),
-            &name,
-        )?));
+    match force.unwrap_or_else(|| format_by_content(&head)) {
+        InputFormat::Csv => {
+            drop(stdin);
+            let rest = std::io::Cursor::new(head).chain(std::io::stdin());
+            return Ok(PathInput::Csv(CsvSource::from_reader(
+                Box::new(rest),
+                &name,
+            )?));
+        }
+        InputFormat::Gcode => {
+            drop(stdin);
+            let rest = std::io::Cursor::new(head).chain(std::io::stdin());
+            let input: Box<dyn BufRead + Send> =
+                Box::new(std::io::BufReader::with_capacity(64 * 1024, rest));
+            let reader = verne_gcode::Reader::new(input, options.gcode)
+                .map_err(|e| gcode_error(&name, &e))?;
+            return Ok(PathInput::Gcode(Box::new(reader), name));
+        }
+        InputFormat::Apt => {}
     }
     (&mut stdin)
         .take(MAX_STDIN_CL_BYTES + 1)
@@ -99,7 +153,7 @@ pub fn open_path_input(
         ));
     }
     let input: Box<dyn SeekableInput> = Box::new(std::io::Cursor::new(head));
-    let reader = Reader::new(input, options).map_err(|e| cl_error(&name, &e))?;
+    let reader = Reader::new(input, options.cl).map_err(|e| cl_error(&name, &e))?;
     Ok(PathInput::Cl(Box::new(reader), name))
 }
 
@@ -192,100 +246,65 @@ fn shortened(items: &[String], n: usize) -> String {
 
 /// A CL file read as CSV text (`line,kind,motion,feed,tool,x,y,z,i,j,k`, mm, unit axis), so
 /// that `verne ik` streams it through the same row engine as a CSV file. The reader's summary
-/// is shared through `summary` and complete once the text has been read to its end.
-pub struct ClAsCsv {
+/// is shared through [`ClRows::summary`] and complete once the text has been read to its end.
+pub struct ClRows {
     reader: ClReader,
-    buf: Vec<u8>,
-    pos: usize,
-    header_done: bool,
-    finished: bool,
     summary: Arc<Mutex<Summary>>,
 }
 
-impl ClAsCsv {
-    /// The CSV view of `reader`.
-    pub fn new(reader: ClReader) -> ClAsCsv {
+/// [`ClRows`] as CSV text.
+pub type ClAsCsv = AsCsv<ClRows>;
+
+impl ClRows {
+    /// The rows of `reader`.
+    pub fn new(reader: ClReader) -> ClRows {
         let summary = Arc::new(Mutex::new(reader.summary().clone()));
-        ClAsCsv {
-            reader,
-            buf: Vec::with_capacity(256),
-            pos: 0,
-            header_done: false,
-            finished: false,
-            summary,
-        }
+        ClRows { reader, summary }
     }
 
     /// The reader's summary, shared.
     pub fn summary(&self) -> Arc<Mutex<Summary>> {
         self.summary.clone()
     }
+}
 
-    fn refill(&mut self) -> std::io::Result<()> {
-        self.buf.clear();
-        self.pos = 0;
-        if !self.header_done {
-            self.header_done = true;
-            self.buf
-                .extend_from_slice(b"line,kind,motion,feed,tool,x,y,z,i,j,k\n");
-            return Ok(());
-        }
-        if self.finished {
-            return Ok(());
-        }
+impl CsvRows for ClRows {
+    fn header(&self) -> &'static [u8] {
+        b"line,kind,motion,feed,tool,x,y,z,i,j,k\n"
+    }
+
+    fn next_row(&mut self, buf: &mut Vec<u8>) -> std::io::Result<bool> {
         match self.reader.next() {
             Some(Ok(r)) => {
                 let (t, a) = (r.tip, r.axis);
-                write!(self.buf, "{},{},{},", r.line, r.kind, r.motion.as_str())?;
+                write!(buf, "{},{},{},", r.line, r.kind, r.motion.as_str())?;
                 if let Some(f) = r.feed_mm_min {
-                    write!(self.buf, "{f}")?;
+                    write!(buf, "{f}")?;
                 }
-                self.buf.push(b',');
+                buf.push(b',');
                 if let Some(n) = r.tool {
-                    write!(self.buf, "{n}")?;
+                    write!(buf, "{n}")?;
                 }
                 writeln!(
-                    self.buf,
+                    buf,
                     ",{},{},{},{},{},{}",
                     t[0], t[1], t[2], a[0], a[1], a[2]
-                )
+                )?;
+                Ok(true)
             }
-            Some(Err(e)) => {
-                self.finished = true;
-                Err(std::io::Error::new(
-                    std::io::ErrorKind::InvalidData,
-                    e.to_string(),
-                ))
-            }
+            Some(Err(e)) => Err(invalid_data(e.to_string())),
             None => {
-                self.finished = true;
                 if let Ok(mut s) = self.summary.lock() {
                     *s = self.reader.summary().clone();
                 }
                 if self.reader.summary().rows == 0 {
                     // As an empty CSV is: nothing to convert is not a success.
-                    return Err(std::io::Error::new(
-                        std::io::ErrorKind::InvalidData,
-                        "no motion record (GOTO, FROM, CIRCLE, GODLTA or a cycle): no tool pose to convert",
+                    return Err(invalid_data(
+                        "no motion record (GOTO, FROM, CIRCLE, GODLTA or a cycle): no tool pose to convert".into(),
                     ));
                 }
-                Ok(())
+                Ok(false)
             }
         }
-    }
-}
-
-impl std::io::Read for ClAsCsv {
-    fn read(&mut self, out: &mut [u8]) -> std::io::Result<usize> {
-        while self.pos >= self.buf.len() {
-            if self.finished && self.header_done {
-                return Ok(0);
-            }
-            self.refill()?;
-        }
-        let n = out.len().min(self.buf.len() - self.pos);
-        out[..n].copy_from_slice(&self.buf[self.pos..self.pos + n]);
-        self.pos += n;
-        Ok(n)
     }
 }

@@ -2,5 +2,7 @@
 //! crate) and the two inputs of `verne verify` ([`verify_files`]). CSV reading itself is in
 //! [`crate::table`].
 
+pub mod as_csv;
 pub mod cl;
+pub mod gcode;
 pub mod verify_files;

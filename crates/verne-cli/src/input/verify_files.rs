@@ -12,7 +12,8 @@ use verne::parallel_module::equations::Sliders;
 use verne::verify::{Item, JOINT_NAMES, JointSource, Joints, PathPoint, RowSource};
 
 use crate::error::VerneError;
-use crate::input::cl::{ClReader, PathInput, cl_error, open_path_input};
+use crate::input::cl::{ClReader, PathInput, ReadOptions, cl_error, open_path_input};
+use crate::input::gcode::{JointProgram, TcpPath, TcpRows};
 use crate::table::{CellError, CsvSource, parse_number};
 
 /// Reads a cell as a number; a non-number is fatal (file, line, column), an empty or non-finite
@@ -48,6 +49,8 @@ pub struct JointReader {
     id: Option<usize>,
     t: Option<usize>,
     feed: Option<usize>,
+    /// `motion` (`rapid` or `feed`, as `verne ik` writes it from a CL file or a program).
+    motion: Option<usize>,
     rec: ByteRecord,
     index: u64,
 }
@@ -60,6 +63,7 @@ impl JointReader {
             id: src.column("id"),
             t: src.column("t"),
             feed: src.column("feed"),
+            motion: src.column("motion"),
             src,
             rec: ByteRecord::new(),
             index: 0,
@@ -81,6 +85,7 @@ enum PathKind {
     Cl {
         reader: Box<ClReader>,
     },
+    Gcode(TcpPath),
 }
 
 /// The intended path: a CSV (`x,y,z` and `i,j,k` or `phi1,phi2` in degrees, optional `id`) or a
@@ -98,12 +103,21 @@ impl PathReader {
     /// `docs/cl-dialects.md`) or CSV. `offset` (mm) is added to every tip.
     pub fn open(
         path: &Path,
-        options: verne_cl::Options,
+        options: &ReadOptions,
         offset: Vector3<f64>,
     ) -> Result<PathReader, VerneError> {
         let mut reader = match open_path_input(Some(path), None, options)? {
             PathInput::Cl(reader, name) => PathReader {
                 kind: PathKind::Cl { reader },
+                name,
+                index: 0,
+                offset,
+            },
+            PathInput::Gcode(reader, name) => PathReader {
+                kind: PathKind::Gcode(TcpPath::new(
+                    TcpRows::new(*reader, &name, &options.words),
+                    offset,
+                )),
                 name,
                 index: 0,
                 offset,
@@ -119,7 +133,16 @@ impl PathReader {
     pub fn cl_summary(&self) -> Option<(&str, &verne_cl::Summary)> {
         match &self.kind {
             PathKind::Cl { reader } => Some((&self.name, reader.summary())),
-            PathKind::Csv { .. } => None,
+            _ => None,
+        }
+    }
+
+    /// What the G-code reader saw besides the rows, and the file's name; `None` for other
+    /// paths.
+    pub fn gcode_summary(&self) -> Option<(&str, verne_gcode::Summary)> {
+        match &self.kind {
+            PathKind::Gcode(p) => Some((&self.name, p.summary())),
+            _ => None,
         }
     }
 
@@ -195,7 +218,14 @@ impl RowSource for JointReader {
                 }
             };
         let t = optional(self.t, "t", "s")?;
-        let feed = optional(self.feed, "feed", "mm/min")?.map(|f| f / 60.0);
+        // A rapid row has no feed (the machine's rapid rate): its empty feed cell is no gap.
+        let rapid = self.motion.is_some_and(|i| {
+            self.rec
+                .get(i)
+                .is_some_and(|m| m.eq_ignore_ascii_case(b"rapid"))
+        });
+        let feed_column = if rapid { None } else { self.feed };
+        let feed = optional(feed_column, "feed", "mm/min")?.map(|f| f / 60.0);
         let id = self
             .id
             .map(|i| String::from_utf8_lossy(self.rec.get(i).unwrap_or(b"")).into_owned());
@@ -207,6 +237,8 @@ impl RowSource for JointReader {
                 theta2: v[4],
                 t,
                 feed,
+                duration: None,
+                rapid,
             }),
         };
         Ok(Some(Item {
@@ -239,6 +271,7 @@ impl RowSource for PathReader {
 
     fn next_item(&mut self) -> Result<Option<Item<PathPoint>>, VerneError> {
         match &mut self.kind {
+            PathKind::Gcode(p) => p.next_item(),
             PathKind::Cl { reader } => {
                 let row = match reader.next() {
                     None => return Ok(None),
@@ -252,6 +285,7 @@ impl RowSource for PathReader {
                         axis,
                         rapid: row.motion == verne_cl::Motion::Rapid,
                         feed: row.feed_mm_min.map(|f| f / 60.0),
+                        duration: None,
                     })
                     .map_err(|e| format!("{} at line {}: {e}", row.kind, row.line));
                 Ok(Some(Item {
@@ -318,6 +352,88 @@ impl RowSource for PathReader {
                     value,
                 }))
             }
+        }
+    }
+}
+
+/// The joint table of `verne verify`: a CSV, or a G-code joint program (by its extension or
+/// its first block; `[gcode]` of the machine file names the joints).
+#[allow(clippy::large_enum_variant)] // one per run
+pub enum JointInput {
+    Csv(JointReader),
+    Gcode(JointProgram),
+}
+
+impl JointInput {
+    /// Opens `path` as a G-code joint program or a CSV joint table.
+    pub fn open(path: &Path, options: &ReadOptions) -> Result<JointInput, VerneError> {
+        let name = path.display().to_string();
+        let gcode = verne_gcode::has_gcode_extension(&name) || {
+            use std::io::Read;
+            let mut head = Vec::with_capacity(verne_cl::SNIFF_BYTES);
+            if path.as_os_str() != "-" {
+                let f =
+                    crate::table::open_input_file(path).map_err(|e| VerneError::io(&name, e))?;
+                f.take(verne_cl::SNIFF_BYTES as u64)
+                    .read_to_end(&mut head)
+                    .map_err(|e| VerneError::io(&name, e))?;
+            }
+            verne_gcode::sniff_content(&head)
+        };
+        if !gcode {
+            return Ok(JointInput::Csv(JointReader::new(CsvSource::open(Some(
+                path,
+            ))?)?));
+        }
+        let f = crate::table::open_input_file(path).map_err(|e| VerneError::io(&name, e))?;
+        let input: Box<dyn std::io::BufRead + Send> =
+            Box::new(std::io::BufReader::with_capacity(64 * 1024, f));
+        let reader = verne_gcode::Reader::new(input, options.gcode)
+            .map_err(|e| crate::input::gcode::gcode_error(&name, &e))?;
+        let program = JointProgram::new(reader, &name, &options.words);
+        Ok(JointInput::Gcode(program))
+    }
+
+    /// What the G-code reader saw besides the rows, for a G-code joint program.
+    pub fn gcode_summary(&self) -> Option<(&str, &verne_gcode::Summary)> {
+        match self {
+            JointInput::Gcode(p) => Some((p.name(), p.summary())),
+            JointInput::Csv(_) => None,
+        }
+    }
+}
+
+impl RowSource for JointInput {
+    type Row = Joints;
+    type Error = VerneError;
+
+    fn name(&self) -> &str {
+        match self {
+            JointInput::Csv(r) => r.name(),
+            JointInput::Gcode(p) => p.name(),
+        }
+    }
+
+    fn has_id(&self) -> bool {
+        match self {
+            JointInput::Csv(r) => r.has_id(),
+            JointInput::Gcode(p) => p.has_id(),
+        }
+    }
+
+    fn next_item(&mut self) -> Result<Option<Item<Joints>>, VerneError> {
+        match self {
+            JointInput::Csv(r) => r.next_item(),
+            JointInput::Gcode(p) => p.next_item(),
+        }
+    }
+}
+
+impl JointSource for JointInput {
+    fn timed(&self) -> bool {
+        match self {
+            JointInput::Csv(r) => r.timed(),
+            JointInput::Gcode(p) => p.timed(),
         }
     }
 }

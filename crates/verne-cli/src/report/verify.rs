@@ -9,6 +9,7 @@ use verne::verify::{Summary, THRESHOLDS};
 pub fn help_text() -> String {
     let mut s = String::from(
         "Example:\n  verne verify --joints data/verify/joints.csv --path data/verify/path.csv\n  \
+         verne verify --joints data/example-post.ngc --path data/example-tcp.ngc\n  \
          verne verify --joints post.csv --path part.cl --report report.csv --format json \\\n    \
          --threshold tip_error_mm=0.01 --threshold lambda_max=4\n\n\
          Thresholds (--threshold NAME=VALUE, or NAME = VALUE in the machine file's [verify] table):\n",

@@ -6,6 +6,7 @@
 
 use std::collections::{HashMap, HashSet};
 
+use super::gcode::{GcodeValue, GcodeWords};
 use super::{Limits, Machine, ModuleGeometry, TableGeometry};
 use crate::error::{MachineError, Problem};
 
@@ -357,7 +358,7 @@ impl Machine {
         let m = &self.module;
         let l = &self.limits;
         format!(
-            "kind = \"verne\"\nname = {:?}\n\n[module]\nD1 = {}\nd1 = 0.0\nR1 = {}\nr1 = {}\nL1 = {}\nD2 = {}\nd2 = 0.0\nR2 = {}\nr4 = {}\nL2 = {}\nL3 = {}\n\n[limits]\nrho1_min = {}\nrho1_max = {}\nrho2_min = {}\nrho2_max = {}\nrho3_min = {}\nrho3_max = {}\nrod_tilt_max = {}\ntheta1_min = {}\ntheta1_max = {}\n\n[table]\nd_a = {}\nd_t = {}\n\n[tool]\nlength = {}\n",
+            "kind = \"verne\"\nname = {:?}\n\n[module]\nD1 = {}\nd1 = 0.0\nR1 = {}\nr1 = {}\nL1 = {}\nD2 = {}\nd2 = 0.0\nR2 = {}\nr4 = {}\nL2 = {}\nL3 = {}\n\n[limits]\nrho1_min = {}\nrho1_max = {}\nrho2_min = {}\nrho2_max = {}\nrho3_min = {}\nrho3_max = {}\nrod_tilt_max = {}\ntheta1_min = {}\ntheta1_max = {}\n\n[table]\nd_a = {}\nd_t = {}\n\n[tool]\nlength = {}\n\n{}",
             self.name,
             m.dx1,
             m.r_big1,
@@ -379,7 +380,8 @@ impl Machine {
             l.theta1_max.to_degrees(),
             self.table.d_a,
             self.table.d_t,
-            self.tool_length
+            self.tool_length,
+            self.gcode.to_toml()
         )
     }
 }
@@ -412,7 +414,7 @@ fn toml_value(v: &toml::Value) -> Value {
 /// Sections that are not tables, or unknown sections, are reported once.
 fn check_sections(table: &toml::Table, lines: &TomlLines) -> Vec<Problem> {
     let mut out = Vec::new();
-    for section in ["module", "limits", "table", "tool", "verify"] {
+    for section in ["module", "limits", "table", "tool", "verify", "gcode"] {
         if let Some(v) = table.get(section)
             && !v.is_table()
         {
@@ -464,6 +466,7 @@ fn finish(
     let mut values = [f64::NAN; SCHEMA.len()];
     let mut kind_seen = false;
     let mut verify = Vec::new();
+    let mut gcode = Vec::new();
     let mut name = String::from("unnamed");
     // Unknown and duplicated keys.
     let mut seen = HashSet::with_capacity(entries.len());
@@ -492,6 +495,15 @@ fn finish(
                     message: "expected \"verne\"".into(),
                 }),
             }
+            continue;
+        }
+        if let Some(key) = e.key.strip_prefix("gcode.") {
+            let value = match &e.value {
+                Value::Number(x) => GcodeValue::Number(*x),
+                Value::Text(s) => GcodeValue::Text(s.clone()),
+                Value::Other(_) => GcodeValue::Other,
+            };
+            gcode.push((key.to_string(), value, e.line));
             continue;
         }
         if let Some(name) = e.key.strip_prefix("verify.") {
@@ -578,6 +590,7 @@ fn finish(
         }
         values[pos] = x;
     }
+    let gcode = GcodeWords::from_entries(&gcode, &mut problems);
     if !kind_seen {
         problems.push(Problem {
             line: None,
@@ -630,6 +643,7 @@ fn finish(
         },
         tool_length: v(22),
         verify,
+        gcode,
     };
     let cross = machine.cross_checks(&line_of);
     if cross.is_empty() {

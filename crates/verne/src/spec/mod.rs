@@ -2,6 +2,7 @@
 //! its machine file (TOML or two-column CSV, [`file`]: schema, reading and validation).
 
 mod file;
+pub mod gcode;
 
 pub use file::MAX_LENGTH_MM;
 
@@ -57,6 +58,8 @@ pub struct Machine {
     /// The optional `[verify]` table: thresholds of `verne verify` by name, as written (the
     /// verify module checks the names and values).
     pub verify: Vec<(String, f64, Option<usize>)>,
+    /// The optional `[gcode]` table: the words of the machine's joint and tool-centre programs.
+    pub gcode: gcode::GcodeWords,
 }
 
 impl Machine {

@@ -135,6 +135,11 @@ pub struct Joints {
     pub t: Option<f64>,
     /// `feed` (mm/s; the column is mm/min).
     pub feed: Option<f64>,
+    /// The time of the move to this row (s), when the joint program states it (a G-code
+    /// program's feed under the controller's rule, or inverse time `G93`).
+    pub duration: Option<f64>,
+    /// The joint program moves to this row at the rapid rate (`G0`): no straight-line checks.
+    pub rapid: bool,
 }
 
 impl Joints {
@@ -155,6 +160,9 @@ pub struct PathPoint {
     /// The programmed feed of the move to this point (mm/s), when the path gives one: the speed
     /// checks use it when the joint table has no `t` or `feed`.
     pub feed: Option<f64>,
+    /// The time of the move to this point (s), when the path states it (a G-code program: the
+    /// controller's feed rule, or inverse time): preferred to `feed`.
+    pub duration: Option<f64>,
 }
 
 impl PathPoint {
@@ -165,6 +173,7 @@ impl PathPoint {
             axis,
             rapid: false,
             feed: None,
+            duration: None,
         }
     }
 }

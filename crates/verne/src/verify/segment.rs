@@ -76,7 +76,7 @@ pub(super) fn eval_segment(m: &Machine, opt: &VerifyOptions, a: &RowEval, b: &Ro
     }
     // A rapid move is not interpolated along the line by the controller: no jump, chord or
     // speed check (its speed is the machine's rapid rate, not a programmed feed).
-    let rapid = pb.rapid;
+    let rapid = pb.rapid || qb.rapid;
     // 6. Joint jumps.
     let step = th.per_joint(Th::RhoStepMm, Th::Theta1StepDeg, Th::Theta2StepDeg);
     let mut jumped = false;
@@ -118,10 +118,11 @@ pub(super) fn eval_segment(m: &Machine, opt: &VerifyOptions, a: &RowEval, b: &Ro
         return s;
     }
     // 6. Velocities: from the joint table's time or feed, else from the path's feed.
-    let dt = match (qa.t, qb.t, qb.feed.or(pb.feed)) {
-        (Some(ta), Some(tb), _) => Some(tb - ta),
+    let dt = match (qa.t, qb.t, qb.duration.or(pb.duration), qb.feed.or(pb.feed)) {
+        (Some(ta), Some(tb), _, _) => Some(tb - ta),
         _ if rapid => None,
-        (_, _, Some(f)) if f > 0.0 => Some((pb.tip - pa.tip).norm() / f),
+        (_, _, Some(d), _) => Some(d),
+        (_, _, _, Some(f)) if f > 0.0 => Some((pb.tip - pa.tip).norm() / f),
         _ => None,
     };
     if let Some(dt) = dt {

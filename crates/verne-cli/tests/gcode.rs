@@ -1,0 +1,296 @@
+//! G-code through the CLI: tool-centre programs into `verne ik` (their joints give back the
+//! programmed poses through `verne fk`), `--format gcode` joint programs read back by
+//! `verne verify --joints` (the shipped example clean, an injected defect found at its line;
+//! the same findings as the CSV post on the CL corpus), the machine file's `[gcode]` letters,
+//! and the refusals that keep one kind of program from being read as the other.
+
+mod common;
+
+use common::{ROOT, col, run, table, table_of};
+
+fn stderr(out: &std::process::Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+fn tmp(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("verne-gcode-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+#[test]
+fn the_joints_of_a_tool_centre_program_give_back_its_poses() {
+    for program in [
+        "data/example-tcp.ngc",
+        "tests/data/gcode/tcp-arcs.ngc",
+        "tests/data/gcode/tcp-inch-cycles.ngc",
+    ] {
+        let ik = run(&["ik", program], None);
+        assert_eq!(ik.status.code(), Some(0), "{program}: {}", stderr(&ik));
+        let (h, rows) = table_of(&ik);
+        assert!(rows.len() > 20, "{program}");
+        // The joints, back through the forward kinematics.
+        let mut joints = String::from("rho1,rho2,rho3,theta1,theta2\n");
+        for r in &rows {
+            let cells: Vec<&str> = ["rho1", "rho2", "rho3", "theta1", "theta2"]
+                .iter()
+                .map(|c| r[col(&h, c)].as_str())
+                .collect();
+            joints.push_str(&cells.join(","));
+            joints.push('\n');
+        }
+        let fk = run(&["fk"], Some(&joints));
+        assert_eq!(fk.status.code(), Some(0), "{program}: {}", stderr(&fk));
+        let (fh, back) = table_of(&fk);
+        assert_eq!(back.len(), rows.len());
+        let num = |s: &str| s.parse::<f64>().unwrap();
+        for (r, b) in rows.iter().zip(&back) {
+            for c in ["x", "y", "z", "i", "j", "k"] {
+                let (want, got) = (num(&r[col(&h, c)]), num(&b[col(&fh, c)]));
+                assert!(
+                    (want - got).abs() < 1e-6,
+                    "{program} line {}: {c} {want} vs {got}",
+                    r[0]
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn the_shipped_post_is_what_ik_writes_and_verifies_clean() {
+    let written = tmp("example-post.ngc");
+    let ik = run(
+        &[
+            "ik",
+            "data/example-tcp.ngc",
+            "--format",
+            "gcode",
+            "-o",
+            written.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert_eq!(ik.status.code(), Some(0), "{}", stderr(&ik));
+    let shipped = std::fs::read_to_string(format!("{ROOT}/data/example-post.ngc")).unwrap();
+    let made = std::fs::read_to_string(&written).unwrap();
+    let tail = |s: &str| {
+        s.lines()
+            .skip(1)
+            .skip_while(|l| l.starts_with('('))
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    assert_eq!(
+        tail(&made),
+        tail(&shipped),
+        "data/example-post.ngc is stale: rerun the command in the README"
+    );
+    let v = run(
+        &[
+            "verify",
+            "--joints",
+            "data/example-post.ngc",
+            "--path",
+            "data/example-tcp.ngc",
+        ],
+        None,
+    );
+    assert_eq!(v.status.code(), Some(0), "{}", stderr(&v));
+    assert!(stderr(&v).contains("clean"), "{}", stderr(&v));
+}
+
+#[test]
+fn a_defect_in_the_post_is_found_at_its_block() {
+    let shipped = std::fs::read_to_string(format!("{ROOT}/data/example-post.ngc")).unwrap();
+    // Move one slider of one block by 0.5 mm.
+    let target = shipped
+        .lines()
+        .position(|l| l.starts_with("N700 "))
+        .expect("block N700");
+    let mut lines: Vec<String> = shipped.lines().map(str::to_string).collect();
+    let words: Vec<String> = lines[target]
+        .split(' ')
+        .map(|w| match w.strip_prefix('V') {
+            Some(v) => format!("V{}", v.parse::<f64>().unwrap() + 0.5),
+            None => w.to_string(),
+        })
+        .collect();
+    lines[target] = words.join(" ");
+    let bad = tmp("bad-post.ngc");
+    std::fs::write(&bad, lines.join("\n") + "\n").unwrap();
+    let report = tmp("report.csv");
+    let v = run(
+        &[
+            "verify",
+            "--joints",
+            bad.to_str().unwrap(),
+            "--path",
+            "data/example-tcp.ngc",
+            "--report",
+            report.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert_eq!(v.status.code(), Some(1), "{}", stderr(&v));
+    let (h, rows) = table(&std::fs::read_to_string(&report).unwrap());
+    let tip_errors: Vec<&Vec<String>> = rows
+        .iter()
+        .filter(|r| r[col(&h, "check")] == "tip_error")
+        .collect();
+    assert_eq!(tip_errors.len(), 1, "{rows:?}");
+    assert_eq!(tip_errors[0][col(&h, "row")], "N700");
+}
+
+#[test]
+fn the_gcode_post_finds_what_the_csv_post_finds() {
+    for path in [
+        "data/example.cl",
+        "tests/data/cl-corpus/nx_basic.cls",
+        "tests/data/cl-corpus/catia_sweep.aptsource",
+        "tests/data/gcode/tcp-arcs.ngc",
+    ] {
+        let mut findings = Vec::new();
+        for format in ["csv", "gcode"] {
+            let post = tmp(&format!("post.{format}"));
+            let ik = run(
+                &["ik", path, "--format", format, "-o", post.to_str().unwrap()],
+                None,
+            );
+            assert_eq!(ik.status.code(), Some(0), "{path}: {}", stderr(&ik));
+            let report = tmp(&format!("report-{format}.csv"));
+            let v = run(
+                &[
+                    "verify",
+                    "--joints",
+                    post.to_str().unwrap(),
+                    "--path",
+                    path,
+                    "--report",
+                    report.to_str().unwrap(),
+                ],
+                None,
+            );
+            assert!(
+                matches!(v.status.code(), Some(0 | 1)),
+                "{path}: {}",
+                stderr(&v)
+            );
+            let (h, rows) = table(&std::fs::read_to_string(&report).unwrap());
+            let mut checks: Vec<String> =
+                rows.iter().map(|r| r[col(&h, "check")].clone()).collect();
+            checks.sort();
+            findings.push(checks);
+        }
+        assert_eq!(findings[0], findings[1], "{path}");
+        assert!(
+            !findings[0].iter().any(|c| c == "input"),
+            "{path}: {:?}",
+            findings[0]
+        );
+    }
+}
+
+#[test]
+fn the_machine_file_names_the_joints() {
+    let default = run(&["machine", "show"], None);
+    let text = String::from_utf8(default.stdout).unwrap();
+    let custom = text
+        .replace("rho1 = \"U\"", "rho1 = \"X\"")
+        .replace("rho2 = \"V\"", "rho2 = \"-Y\"")
+        .replace("rho3 = \"W\"", "rho3 = \"Z\"\nrho3_offset = 100.0")
+        .replace("theta2 = \"C\"", "theta2 = \"B\"");
+    let machine = tmp("letters.toml");
+    std::fs::write(&machine, custom).unwrap();
+    let m = machine.to_str().unwrap();
+    let post = tmp("letters.ngc");
+    let ik = run(
+        &[
+            "ik",
+            "-m",
+            m,
+            "data/example-tcp.ngc",
+            "--format",
+            "gcode",
+            "-o",
+            post.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert_eq!(ik.status.code(), Some(0), "{}", stderr(&ik));
+    let text = std::fs::read_to_string(&post).unwrap();
+    let first = text.lines().find(|l| l.starts_with("N20 ")).unwrap();
+    assert!(
+        first.contains(" Y-") && first.contains(" B") && !first.contains(" U"),
+        "{first}"
+    );
+    let v = run(
+        &[
+            "verify",
+            "-m",
+            m,
+            "--joints",
+            post.to_str().unwrap(),
+            "--path",
+            "data/example-tcp.ngc",
+        ],
+        None,
+    );
+    assert_eq!(v.status.code(), Some(0), "{}", stderr(&v));
+    // Read with the default letters, the same program is refused at its first block.
+    let v = run(
+        &[
+            "verify",
+            "--joints",
+            post.to_str().unwrap(),
+            "--path",
+            "data/example-tcp.ngc",
+        ],
+        None,
+    );
+    assert_eq!(v.status.code(), Some(2));
+    let e = stderr(&v);
+    assert!(
+        e.contains("not a joint word") && e.contains("tool-centre program"),
+        "{e}"
+    );
+    let bad = tmp("bad-letters.toml");
+    std::fs::write(
+        &bad,
+        String::from_utf8(run(&["machine", "show"], None).stdout)
+            .unwrap()
+            .replace("theta1 = \"A\"", "theta1 = \"U\""),
+    )
+    .unwrap();
+    let c = run(&["machine", "check", bad.to_str().unwrap()], None);
+    assert_eq!(c.status.code(), Some(2));
+    assert!(stderr(&c).contains("gcode.theta1"), "{}", stderr(&c));
+}
+
+#[test]
+fn one_kind_of_program_is_never_read_as_the_other() {
+    // A joint program given as the intended path.
+    let v = run(&["ik", "data/example-post.ngc"], None);
+    assert_eq!(v.status.code(), Some(2));
+    let e = stderr(&v);
+    assert!(
+        e.contains("not a word of a tool-centre program") && e.contains("line 6"),
+        "{e}"
+    );
+    // An incomplete first pose, on stdin (sniffed as G-code, not CSV).
+    let v = run(&["ik"], Some("G21 G90\nG0 X0 Y0 Z100\nM2\n"));
+    assert_eq!(v.status.code(), Some(2));
+    let e = stderr(&v);
+    assert!(
+        e.contains("<stdin>") && e.contains("line 2") && e.contains("A C not given"),
+        "{e}"
+    );
+    // What the reader does not evaluate, with its line and column.
+    let v = run(&["ik"], Some("G21 G90\nG0 X#1 Y0 Z100 A0 C0\nM2\n"));
+    assert_eq!(v.status.code(), Some(2));
+    let e = stderr(&v);
+    assert!(
+        e.contains("line 2, column 5") && e.contains("parameters"),
+        "{e}"
+    );
+}
