@@ -2,6 +2,7 @@
 # linuxcnc-sim.sh: verne's kinematics inside a real LinuxCNC, headless, checked by verne.
 #   1. installs LinuxCNC from Debian's packages (linuxcnc-uspace, linuxcnc-uspace-dev) and a C
 #      toolchain, when missing;
+#   1b. compares verne's G-code reader with LinuxCNC's rs274 on tests/data/gcode;
 #   2. builds the C interface (crates/verne-kins, a static library) and the verne binary, then the
 #      kinematics component linuxcnc/vernekins.comp with halcompile, and installs it;
 #   3. runs LinuxCNC headless (`linuxcnc -r`, a Python display, loopback joints, halsampler
@@ -52,6 +53,13 @@ done
 /usr/bin/python3 -c 'import linuxcnc, hal' || die "Debian's python3 cannot import linuxcnc"
 echo "linuxcnc-uspace $(dpkg-query -W -f='${Version}' linuxcnc-uspace)"
 lap "install"
+
+say "1b. verne's G-code reader against LinuxCNC's interpreter (rs274 -g, every program of tests/data/gcode)"
+(cd "$ROOT" && VERNE_REQUIRE_RS274=1 PATH="$(dirname "$CARGO"):$PATH" \
+    "$CARGO" test -q -p verne-gcode --test rs274) > "$RUN/rs274.log" 2>&1 \
+    || { tail -40 "$RUN/rs274.log"; die "verne-gcode against rs274"; }
+grep 'test result' "$RUN/rs274.log"
+lap "rs274"
 
 say "2. build: the C interface, verne, the component"
 (cd "$ROOT" && PATH="$(dirname "$CARGO"):$PATH" "$CARGO" build --release -q -p verne-kins -p verne-cli) \

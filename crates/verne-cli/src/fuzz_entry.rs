@@ -73,6 +73,46 @@ pub fn apt_file(data: &[u8]) {
     verne_cl::fuzz_read(data);
 }
 
+/// A G-code program, any bytes: the reader's invariants (`verne_gcode::fuzz_read`), then the
+/// CLI's readings of it as a tool-centre program and as a joint program (default words, and
+/// the tool-vector form), which must end in rows or an error, never a panic.
+pub fn gcode_file(data: &[u8]) {
+    use crate::input::gcode::{JointProgram, TcpRows};
+    use verne::spec::gcode::{GcodeOrientation, GcodeWords};
+    use verne::verify::RowSource;
+    verne_gcode::fuzz_read(data);
+    let vector = GcodeWords {
+        orientation: GcodeOrientation::Vector,
+        ..GcodeWords::default()
+    };
+    for words in [GcodeWords::default(), vector] {
+        let options = crate::input::gcode::options(0.01, None, &words);
+        let open = || -> Option<crate::input::gcode::GcodeReader> {
+            let input: Box<dyn std::io::BufRead + Send> =
+                Box::new(std::io::Cursor::new(data.to_vec()));
+            verne_gcode::Reader::new(input, options).ok()
+        };
+        if let Some(reader) = open() {
+            let mut rows = TcpRows::new(reader, "fuzz.ngc", &words);
+            for _ in 0..100_000 {
+                match rows.next_pose() {
+                    Some(Ok(p)) => assert!(p.tip.iter().all(|v| v.is_finite()), "tip"),
+                    _ => break,
+                }
+            }
+        }
+        if let Some(reader) = open() {
+            let mut joints = JointProgram::new(reader, "fuzz.ngc", &words);
+            for _ in 0..100_000 {
+                match joints.next_item() {
+                    Ok(Some(_)) => {}
+                    _ => break,
+                }
+            }
+        }
+    }
+}
+
 /// The command-line value parsers, on any text.
 pub fn arg_values(data: &[u8]) {
     if let Ok(text) = std::str::from_utf8(data) {

@@ -27,6 +27,7 @@ fn fuzz_corpus_replays_without_panics() {
         replay("csv_tool", verne_cli::fuzz_entry::csv_tool_rows),
         replay("machine_file", verne_cli::fuzz_entry::machine_file),
         replay("apt_file", verne_cli::fuzz_entry::apt_file),
+        replay("gcode_file", verne_cli::fuzz_entry::gcode_file),
         replay("arg_values", verne_cli::fuzz_entry::arg_values),
     ];
     for c in counts {
