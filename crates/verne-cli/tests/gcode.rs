@@ -251,7 +251,7 @@ fn the_machine_file_names_the_joints() {
     assert_eq!(v.status.code(), Some(2));
     let e = stderr(&v);
     assert!(
-        e.contains("not a joint word") && e.contains("tool-centre program"),
+        e.contains("are not words of a joint program") && e.contains("tool-centre program"),
         "{e}"
     );
     let bad = tmp("bad-letters.toml");
@@ -274,7 +274,7 @@ fn one_kind_of_program_is_never_read_as_the_other() {
     assert_eq!(v.status.code(), Some(2));
     let e = stderr(&v);
     assert!(
-        e.contains("not a word of a tool-centre program") && e.contains("line 6"),
+        e.contains("are not words of a tool-centre program") && e.contains("line 6"),
         "{e}"
     );
     // An incomplete first pose, on stdin (sniffed as G-code, not CSV).
@@ -293,4 +293,44 @@ fn one_kind_of_program_is_never_read_as_the_other() {
         e.contains("line 2, column 5") && e.contains("parameters"),
         "{e}"
     );
+}
+
+#[test]
+fn ik_reports_where_the_joints_went() {
+    let ik = run(&["ik", "data/example-tcp.ngc"], None);
+    assert_eq!(ik.status.code(), Some(0));
+    let (h, rows) = table_of(&ik);
+    let e = stderr(&ik);
+    let line = e
+        .lines()
+        .find(|l| l.contains("joint travel"))
+        .unwrap_or_else(|| panic!("{e}"));
+    for (name, unit) in [
+        ("rho1", "mm"),
+        ("rho2", "mm"),
+        ("rho3", "mm"),
+        ("theta1", "deg"),
+        ("theta2", "deg"),
+    ] {
+        let v: Vec<f64> = rows
+            .iter()
+            .map(|r| r[col(&h, name)].parse().unwrap())
+            .collect();
+        let (lo, hi) = v
+            .iter()
+            .fold((f64::MAX, f64::MIN), |(a, b), &x| (a.min(x), b.max(x)));
+        let want = format!("{name} {lo:.3}..{hi:.3} {unit}");
+        assert!(line.contains(&want), "{want} not in {line}");
+    }
+    // The turns of theta2, as the rows give them (at the vertical rows theta2 keeps its value).
+    let t2: Vec<f64> = rows
+        .iter()
+        .map(|r| r[col(&h, "theta2")].parse().unwrap())
+        .collect();
+    let travel: f64 = t2.windows(2).map(|w| (w[1] - w[0]).abs()).sum::<f64>() / 360.0;
+    assert!(
+        line.contains(&format!("({travel:.2} turns travelled)")),
+        "{line}"
+    );
+    assert!(line.contains("margins"), "{line}");
 }

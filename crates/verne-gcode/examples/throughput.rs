@@ -13,7 +13,11 @@ use verne_gcode::{Options, Reader};
 
 fn write_program(path: &std::path::Path, blocks: usize) -> u64 {
     let mut w = BufWriter::new(File::create(path).unwrap());
-    writeln!(w, "%\n(throughput)\nG21 G90 G17 G94 G40 G49 G80\nG0 X0 Y0 Z50 A0 C0").unwrap();
+    writeln!(
+        w,
+        "%\n(throughput)\nG21 G90 G17 G94 G40 G49 G80\nG0 X0 Y0 Z50 A0 C0"
+    )
+    .unwrap();
     let mut s = 12345u64;
     let (mut x, mut y) = (0.0f64, 0.0f64);
     for n in 0..blocks {
@@ -55,7 +59,8 @@ fn main() {
         .nth(1)
         .and_then(|s| s.parse().ok())
         .unwrap_or(1_000_000);
-    let path = std::env::temp_dir().join(format!("verne-gcode-throughput-{}.ngc", std::process::id()));
+    let path =
+        std::env::temp_dir().join(format!("verne-gcode-throughput-{}.ngc", std::process::id()));
     let bytes = write_program(&path, blocks);
     let mut best = f64::INFINITY;
     let mut rows = 0;

@@ -27,7 +27,11 @@ pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
         }
         u.gcode = Some(machine.gcode);
     }
-    let format_name = if u.halstreamer { "halstreamer" } else { "gcode" };
+    let format_name = if u.halstreamer {
+        "halstreamer"
+    } else {
+        "gcode"
+    };
     if u.every_row_needed() && args.all {
         return Err(VerneError::Usage(format!(
             "--format {format_name} writes one joint row per pose; it cannot be combined with --all"
@@ -36,6 +40,7 @@ pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
     let tool_length = args.tool_length.unwrap_or(machine.tool_length);
     let mut cl_summary = None;
     let mut gcode_summary = None;
+    let mut travel = None;
     let source = if !args.pose.is_empty() {
         inline_source(
             "xp,yp,zp",
@@ -85,9 +90,15 @@ pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
                 Prefer::Orientation1 => FirstRowChoice::Orientation1,
                 Prefer::Orientation2 => FirstRowChoice::Orientation2,
             };
+            let machine_for_travel = machine.clone();
             let mut job = MachineIk::new(machine, tool_length, orientation, args.all, first);
             job.offset = offset;
-            run_rows("ik", &mut job, source, args.output.as_ref(), u)?
+            let code = run_rows("ik", &mut job, source, args.output.as_ref(), u)?;
+            // A CAM job (a CL file or a program): where the joints went, against the limits.
+            if (cl_summary.is_some() || gcode_summary.is_some()) && job.travel.rows > 0 {
+                travel = Some(job.travel.line(&machine_for_travel));
+            }
+            code
         }
         (false, _) => {
             if args.part.offset.is_some() {
@@ -96,7 +107,9 @@ pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
                 ));
             }
             if u.every_row_needed() {
-                return Err(VerneError::Usage(format!("--format {format_name} writes machine joints: give tool poses (x,y,z with i,j,k or phi1,phi2), not platform points")));
+                return Err(VerneError::Usage(format!(
+                    "--format {format_name} writes machine joints: give tool poses (x,y,z with i,j,k or phi1,phi2), not platform points"
+                )));
             }
             let output = args.output.as_ref();
             if args.all {
@@ -115,6 +128,9 @@ pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
         && let Ok(s) = summary.lock()
     {
         crate::input::gcode::report_summary("ik", &name, &s);
+    }
+    if let Some(line) = travel {
+        sayln!("verne ik: {line}");
     }
     Ok(code)
 }

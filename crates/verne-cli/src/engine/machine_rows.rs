@@ -55,6 +55,73 @@ pub struct MachineIk {
     pub state: PathState,
     /// Where the part sits on the table (mm, `--offset`): added to every tip read.
     pub offset: Vector3<f64>,
+    /// The joints' travel over the ok rows of the path.
+    pub travel: JointTravel,
+}
+
+/// Where each joint went along a path: its range over the ok rows, and how far theta2 turned.
+#[derive(Debug, Clone, Default)]
+pub struct JointTravel {
+    pub rows: u64,
+    /// rho1, rho2, rho3 (mm), theta1, theta2 (rad).
+    pub min: [f64; 5],
+    pub max: [f64; 5],
+    /// Sum of |change of theta2| from row to row (rad).
+    pub theta2_travel: f64,
+    last_theta2: Option<f64>,
+}
+
+impl JointTravel {
+    fn add(&mut self, q: [f64; 5]) {
+        if self.rows == 0 {
+            self.min = q;
+            self.max = q;
+        }
+        for ((lo, hi), v) in self.min.iter_mut().zip(self.max.iter_mut()).zip(q) {
+            *lo = lo.min(v);
+            *hi = hi.max(v);
+        }
+        if let Some(t) = self.last_theta2 {
+            self.theta2_travel += (q[4] - t).abs();
+        }
+        self.last_theta2 = Some(q[4]);
+        self.rows += 1;
+    }
+
+    /// One line for stderr: each joint's range and its margins to the machine's limits (mm and
+    /// degrees; theta2 is unlimited, its turns are given instead).
+    pub fn line(&self, m: &Machine) -> String {
+        let l = &m.limits;
+        let mut parts = Vec::new();
+        for k in 0..3 {
+            parts.push(format!(
+                "rho{} {:.3}..{:.3} mm (margins {:.3} / {:.3})",
+                k + 1,
+                self.min[k],
+                self.max[k],
+                self.min[k] - l.rho_min[k],
+                l.rho_max[k] - self.max[k]
+            ));
+        }
+        parts.push(format!(
+            "theta1 {:.3}..{:.3} deg (margins {:.3} / {:.3})",
+            self.min[3].to_degrees(),
+            self.max[3].to_degrees(),
+            (self.min[3] - l.theta1_min).to_degrees(),
+            (l.theta1_max - self.max[3]).to_degrees()
+        ));
+        parts.push(format!(
+            "theta2 {:.3}..{:.3} deg ({:.2} turns travelled)",
+            self.min[4].to_degrees(),
+            self.max[4].to_degrees(),
+            self.theta2_travel / std::f64::consts::TAU
+        ));
+        format!(
+            "joint travel over {} ok rows: {}",
+            self.rows,
+            parts.join(", ")
+        )
+    }
 }
 
 impl MachineIk {
@@ -72,6 +139,7 @@ impl MachineIk {
             all,
             state: PathState::new(first),
             offset: Vector3::zeros(),
+            travel: JointTravel::default(),
         }
     }
 }
@@ -218,6 +286,8 @@ impl RowJob for MachineIk {
         }
         match self.state.choose(candidates) {
             Ok(row) => {
+                self.travel
+                    .add([row.rho.x, row.rho.y, row.rho.z, row.theta1, row.theta2]);
                 let flags = match (row.near_rotary_singularity, row.switched) {
                     (true, true) => "near_rotary_singularity;orientation_switch",
                     (true, false) => "near_rotary_singularity",

@@ -42,6 +42,15 @@ fn letters(mask: u16) -> String {
     v.join(" ")
 }
 
+/// `is not a word of` or `are not words of`, for the letters of a mask.
+fn not_words(mask: u16) -> &'static str {
+    if mask.count_ones() == 1 {
+        "is not a word of"
+    } else {
+        "are not words of"
+    }
+}
+
 fn axis_of(letter: char) -> Axis {
     // The machine file's letters are validated (X Y Z A B C U V W).
     Axis::from_letter(letter as u8).unwrap_or(Axis::X)
@@ -149,8 +158,9 @@ impl TcpRows {
         let stray = row.written & !self.allowed;
         if stray != 0 {
             return fail(format!(
-                "{} is not a word of a tool-centre program ({}; the machine file's [gcode] table): is this a joint program? check it with verne verify --joints",
+                "{} {} a tool-centre program ({}; the machine file's [gcode] table): is this a joint program? check it with verne verify --joints",
                 letters(stray),
+                not_words(stray),
                 self.words()
             ));
         }
@@ -357,8 +367,9 @@ impl RowSource for JointProgram {
         let stray = row.written & !self.allowed;
         if stray != 0 {
             return fail(format!(
-                "{} is not a joint word of the machine ({}; the machine file's [gcode] table): is this a tool-centre program? give it with --path",
+                "{} {} a joint program of the machine ({}; the machine file's [gcode] table): is this a tool-centre program? give it with --path",
                 letters(stray),
+                not_words(stray),
                 self.joint_words()
             ));
         }
