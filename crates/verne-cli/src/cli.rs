@@ -124,6 +124,13 @@ pub struct IkArgs {
     /// Output CSV (written atomically); absent or `-` writes stdout.
     #[arg(short = 'o', long = "output", value_name = "FILE")]
     pub output: Option<PathBuf>,
+    /// Resample the toolpath at this servo period (1ms, 250us, 0.001s) from its feeds: one row
+    /// per period, as LinuxCNC's halstreamer plays them; CSV output gains a `t` column (s).
+    #[arg(long, value_name = "PERIOD", value_parser = crate::input::resample::parse_period)]
+    pub period: Option<f64>,
+    /// The machine's rapid rate (mm/min) that times rapid moves under --period.
+    #[arg(long, value_name = "MM_MIN", value_parser = parse_positive, requires = "period")]
+    pub rapid: Option<f64>,
     /// Every real branch, one row each, instead of the machine's working branch.
     #[arg(long)]
     pub all: bool,

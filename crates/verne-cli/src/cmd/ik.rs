@@ -9,8 +9,10 @@ use verne::machine::FirstRowChoice;
 
 use super::{inline_source, load_machine, run_rows, units};
 use crate::cli::{IkArgs, OutputFormat, Prefer};
+use crate::input::as_csv::AsCsv;
 use crate::input::cl::{ClAsCsv, ClRows, PathInput, open_path_input, report_summary};
 use crate::input::gcode::{TcpAsCsv, TcpRows};
+use crate::input::resample::Resampler;
 
 pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
     if let Some(spec) = super::glider::load(args.common.machine.as_deref())? {
@@ -68,6 +70,19 @@ pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
                     .with_line_column("line")
             }
         }
+    };
+    let source = match args.period {
+        Some(period) => {
+            if source.column("xp").is_some() && source.column("x").is_none() {
+                return Err(VerneError::Usage(
+                    "--period resamples a toolpath of tool poses (x,y,z with i,j,k or phi1,phi2), not platform points".into(),
+                ));
+            }
+            let name = source.name().to_string();
+            let rows = Resampler::new(source, period, args.rapid, args.common.radians)?;
+            CsvSource::from_reader(Box::new(AsCsv::new(rows)), &name)?.with_line_column("line")
+        }
+        None => source,
     };
     let offset = args.part.offset();
     let has = |c: &str| source.column(c).is_some();
@@ -131,6 +146,11 @@ pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
     }
     if let Some(line) = travel {
         sayln!("verne ik: {line}");
+    }
+    if u.halstreamer && args.period.is_none() {
+        sayln!(
+            "verne ik: note: one row per path point, not per servo period (halstreamer plays one row per period: --period 1ms plays the path at its feeds)"
+        );
     }
     Ok(code)
 }

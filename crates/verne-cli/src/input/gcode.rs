@@ -191,7 +191,7 @@ impl TcpRows {
 
 impl CsvRows for TcpRows {
     fn header(&self) -> &'static [u8] {
-        b"line,n,kind,motion,feed,tool,x,y,z,i,j,k\n"
+        b"line,n,kind,motion,feed,dt,tool,x,y,z,i,j,k\n"
     }
 
     fn next_row(&mut self, buf: &mut Vec<u8>) -> std::io::Result<bool> {
@@ -226,6 +226,11 @@ impl CsvRows for TcpRows {
                 write!(buf, ",{},{},", r.kind.as_str(), r.motion.as_str())?;
                 if let Some(f) = r.feed_per_min.filter(|_| r.motion == Motion::Feed) {
                     write!(buf, "{f}")?;
+                }
+                buf.push(b',');
+                // The time of the move as the program states it (its feed, G93), s.
+                if let Some(d) = r.duration_s {
+                    write!(buf, "{d}")?;
                 }
                 buf.push(b',');
                 if let Some(t) = r.tool {

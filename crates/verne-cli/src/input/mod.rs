@@ -5,4 +5,5 @@
 pub mod as_csv;
 pub mod cl;
 pub mod gcode;
+pub mod resample;
 pub mod verify_files;

@@ -1,0 +1,345 @@
+//! `verne ik --period`: a toolpath resampled at the controller's servo period, so that a joint
+//! stream played one row per period (LinuxCNC's halstreamer) reproduces the programmed speed.
+//! Each move takes the time its feed gives (the tool tip's path at the feed, or, when the tip
+//! stays, the axis's turn in degrees at the feed, as the G-code post times it; a G-code
+//! program's own time of the move where it states one, `G93`; rapids at `--rapid`); the tool
+//! pose is sampled at every multiple of the period, the tip on the straight line and the axis
+//! turning at a constant rate in the plane of its two ends (slerp), and each sample is then
+//! solved by the inverse kinematics like any row.
+
+use std::io::{self, Write};
+
+use csv::ByteRecord;
+use nalgebra::Vector3;
+use verne::machine::orientation::tool_axis;
+
+use crate::error::VerneError;
+use crate::input::as_csv::{CsvRows, invalid_data};
+use crate::table::{CsvSource, parse_number};
+
+/// Most samples written per call (the rest of a long move is written on the next calls).
+const SAMPLES_PER_CALL: u64 = 1024;
+
+#[derive(Clone, Copy)]
+enum Orientation {
+    Axis([usize; 3]),
+    /// phi1, phi2 columns, and whether they are in radians.
+    Angles([usize; 2], bool),
+}
+
+#[derive(Clone, Copy)]
+struct Pose {
+    tip: Vector3<f64>,
+    axis: Vector3<f64>,
+}
+
+/// The move being sampled: from `a` at `t0` to `b` at `t1` (s).
+struct Move {
+    a: Pose,
+    b: Pose,
+    t0: f64,
+    t1: f64,
+    line: String,
+}
+
+/// A CSV toolpath (x,y,z with i,j,k or phi1,phi2, and feed, motion, line, dt when present)
+/// resampled at a period; rows `line,t,x,y,z,i,j,k`.
+pub struct Resampler {
+    src: CsvSource,
+    line: Option<usize>,
+    motion: Option<usize>,
+    feed: Option<usize>,
+    dt: Option<usize>,
+    xyz: [usize; 3],
+    orientation: Orientation,
+    period: f64,
+    rapid_mm_min: Option<f64>,
+    rec: ByteRecord,
+    current: Option<Move>,
+    /// Index of the next sample (time = index * period).
+    tick: u64,
+    last: Option<(Pose, f64, String)>,
+    done: bool,
+}
+
+impl Resampler {
+    /// Resamples `src` every `period` seconds; rapids at `rapid_mm_min` (mm/min) when given.
+    pub fn new(
+        src: CsvSource,
+        period: f64,
+        rapid_mm_min: Option<f64>,
+        radians: bool,
+    ) -> Result<Resampler, VerneError> {
+        let has = |c: &str| src.column(c).is_some();
+        let orientation = if has("i") || !has("phi1") {
+            let c = src.require(&["x", "y", "z", "i", "j", "k"])?;
+            Orientation::Axis([c[3], c[4], c[5]])
+        } else {
+            let c = src.require(&["x", "y", "z", "phi1", "phi2"])?;
+            Orientation::Angles([c[3], c[4]], radians)
+        };
+        let xyz = src.require(&["x", "y", "z"])?;
+        if src.column("feed").is_none() && src.column("dt").is_none() {
+            return Err(VerneError::input(
+                src.name(),
+                Some(1),
+                None,
+                "--period times each move by its feed: the input needs a `feed` column (mm/min), as CL files and G-code programs give",
+            ));
+        }
+        Ok(Resampler {
+            line: src.column("line"),
+            motion: src.column("motion"),
+            feed: src.column("feed"),
+            dt: src.column("dt"),
+            xyz: [xyz[0], xyz[1], xyz[2]],
+            orientation,
+            period,
+            rapid_mm_min,
+            rec: ByteRecord::new(),
+            current: None,
+            tick: 0,
+            last: None,
+            done: false,
+            src,
+        })
+    }
+
+    fn number(&self, i: usize, what: &str, line: &str) -> io::Result<f64> {
+        parse_number(self.rec.get(i).unwrap_or(b"")).map_err(|_| {
+            invalid_data(format!(
+                "line {line}: expected a number in `{what}`, found `{}`",
+                String::from_utf8_lossy(self.rec.get(i).unwrap_or(b""))
+            ))
+        })
+    }
+
+    /// The next pose of the input and its line, or `None` at the end.
+    fn next_pose(&mut self) -> io::Result<Option<(Pose, String)>> {
+        let more = self
+            .src
+            .read(&mut self.rec)
+            .map_err(|e| invalid_data(e.to_string()))?;
+        if !more {
+            return Ok(None);
+        }
+        let line = match self.line {
+            Some(i) => String::from_utf8_lossy(self.rec.get(i).unwrap_or(b"")).into_owned(),
+            None => self
+                .rec
+                .position()
+                .map(|p| p.line().to_string())
+                .unwrap_or_default(),
+        };
+        let tip = Vector3::new(
+            self.number(self.xyz[0], "x", &line)?,
+            self.number(self.xyz[1], "y", &line)?,
+            self.number(self.xyz[2], "z", &line)?,
+        );
+        let axis = match self.orientation {
+            Orientation::Axis(c) => {
+                let v = Vector3::new(
+                    self.number(c[0], "i", &line)?,
+                    self.number(c[1], "j", &line)?,
+                    self.number(c[2], "k", &line)?,
+                );
+                let n = v.norm();
+                if n.is_nan() || n <= 1e-12 {
+                    return Err(invalid_data(format!("line {line}: the tool axis is zero")));
+                }
+                v / n
+            }
+            Orientation::Angles(c, radians) => {
+                let to_rad = |v: f64| if radians { v } else { v.to_radians() };
+                tool_axis(
+                    to_rad(self.number(c[0], "phi1", &line)?),
+                    to_rad(self.number(c[1], "phi2", &line)?),
+                )
+            }
+        };
+        Ok(Some((Pose { tip, axis }, line)))
+    }
+
+    /// The time of the move from `a` to the current record's pose `b` (s).
+    fn duration(&self, a: &Pose, b: &Pose, line: &str) -> io::Result<f64> {
+        if let Some(i) = self.dt
+            && let Ok(dt) = parse_number(self.rec.get(i).unwrap_or(b""))
+        {
+            return Ok(dt.max(0.0));
+        }
+        let rapid = self
+            .motion
+            .is_some_and(|i| self.rec.get(i).is_some_and(|m| m == b"rapid"));
+        let rate = if rapid {
+            self.rapid_mm_min.ok_or_else(|| {
+                invalid_data(format!(
+                    "line {line}: a rapid move: --period needs the machine's rapid rate to time it (--rapid MM_MIN)"
+                ))
+            })?
+        } else {
+            self.feed
+                .and_then(|i| parse_number(self.rec.get(i).unwrap_or(b"")).ok())
+                .filter(|f| *f > 0.0)
+                .ok_or_else(|| {
+                    invalid_data(format!(
+                        "line {line}: a feed move without a feed: --period times each move by its feed"
+                    ))
+                })?
+        };
+        let length = (b.tip - a.tip).norm();
+        let turn = a.axis.angle(&b.axis).to_degrees();
+        let per_minute = if length > 1e-9 { length } else { turn };
+        Ok(60.0 * per_minute / rate)
+    }
+
+    fn write_sample(&self, out: &mut Vec<u8>, line: &str, t: f64, p: &Pose) -> io::Result<()> {
+        writeln!(
+            out,
+            "{line},{t:.6},{},{},{},{},{},{}",
+            p.tip.x, p.tip.y, p.tip.z, p.axis.x, p.axis.y, p.axis.z
+        )
+    }
+}
+
+/// The pose a fraction `s` of the way from `a` to `b`: the tip on the line, the axis by slerp.
+fn between(a: &Pose, b: &Pose, s: f64) -> Pose {
+    let tip = a.tip + (b.tip - a.tip) * s;
+    let angle = a.axis.angle(&b.axis);
+    let axis = if angle < 1e-12 {
+        b.axis
+    } else if (std::f64::consts::PI - angle) < 1e-9 {
+        // Opposite axes: no plane to turn in; jump at the end (the IK rows will say so).
+        if s < 1.0 { a.axis } else { b.axis }
+    } else {
+        let w = angle.sin();
+        (a.axis * (((1.0 - s) * angle).sin() / w) + b.axis * ((s * angle).sin() / w)).normalize()
+    };
+    Pose { tip, axis }
+}
+
+impl CsvRows for Resampler {
+    fn header(&self) -> &'static [u8] {
+        b"line,t,x,y,z,i,j,k\n"
+    }
+
+    fn next_row(&mut self, out: &mut Vec<u8>) -> io::Result<bool> {
+        loop {
+            if let Some(m) = &self.current {
+                let mut written = 0;
+                while written < SAMPLES_PER_CALL {
+                    let t = self.tick as f64 * self.period;
+                    if t > m.t1 + 1e-9 * self.period {
+                        break;
+                    }
+                    let s = if m.t1 > m.t0 {
+                        ((t - m.t0) / (m.t1 - m.t0)).clamp(0.0, 1.0)
+                    } else {
+                        1.0
+                    };
+                    let p = between(&m.a, &m.b, s);
+                    self.write_sample(out, &m.line, t, &p)?;
+                    self.tick += 1;
+                    written += 1;
+                }
+                if written > 0 {
+                    return Ok(true);
+                }
+                self.current = None;
+            }
+            if self.done {
+                return Ok(false);
+            }
+            match self.next_pose()? {
+                None => {
+                    self.done = true;
+                    // The end of the path, if it fell between two ticks.
+                    if let Some((p, t, line)) = self.last.take()
+                        && (self.tick as f64 * self.period) - t < self.period * (1.0 - 1e-9)
+                        && self.tick > 0
+                        && ((self.tick - 1) as f64 * self.period) < t - 1e-9 * self.period
+                    {
+                        self.write_sample(out, &line, t, &p)?;
+                        return Ok(true);
+                    }
+                    return Ok(false);
+                }
+                Some((b, line)) => match self.last.take() {
+                    None => {
+                        self.last = Some((b, 0.0, line.clone()));
+                        self.current = Some(Move {
+                            a: b,
+                            b,
+                            t0: 0.0,
+                            t1: 0.0,
+                            line,
+                        });
+                    }
+                    Some((a, t0, _)) => {
+                        let d = self.duration(&a, &b, &line)?;
+                        let t1 = t0 + d;
+                        self.last = Some((b, t1, line.clone()));
+                        self.current = Some(Move { a, b, t0, t1, line });
+                    }
+                },
+            }
+        }
+    }
+}
+
+/// Parses a servo period: `1ms`, `250us`, `0.001s` or seconds (`0.001`); > 0.
+pub fn parse_period(s: &str) -> Result<f64, String> {
+    let t = s.trim();
+    let (number, scale) = if let Some(v) = t.strip_suffix("ms") {
+        (v, 1e-3)
+    } else if let Some(v) = t.strip_suffix("us") {
+        (v, 1e-6)
+    } else if let Some(v) = t.strip_suffix('s') {
+        (v, 1.0)
+    } else {
+        (t, 1.0)
+    };
+    match number.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 && v * scale >= 1e-6 && v * scale <= 10.0 => {
+            Ok(v * scale)
+        }
+        Ok(_) => Err(format!("`{s}`: the period must be between 1us and 10s")),
+        Err(_) => Err(format!(
+            "`{s}` is not a period: expected e.g. 1ms, 250us, 0.001s"
+        )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn periods() {
+        assert_eq!(parse_period("1ms"), Ok(1e-3));
+        assert_eq!(parse_period("250us"), Ok(250e-6));
+        assert_eq!(parse_period("0.002s"), Ok(0.002));
+        assert_eq!(parse_period("0.004"), Ok(0.004));
+        assert!(parse_period("0ms").is_err());
+        assert!(parse_period("fast").is_err());
+        assert!(parse_period("1ns").is_err());
+    }
+
+    #[test]
+    fn slerp_keeps_unit_axes_and_turns_evenly() {
+        let a = Pose {
+            tip: Vector3::zeros(),
+            axis: Vector3::z(),
+        };
+        let b = Pose {
+            tip: Vector3::new(10.0, 0.0, 0.0),
+            axis: Vector3::x(),
+        };
+        for k in 0..=10 {
+            let s = k as f64 / 10.0;
+            let p = between(&a, &b, s);
+            assert!((p.axis.norm() - 1.0).abs() < 1e-12);
+            assert!((p.axis.angle(&a.axis) - s * std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+            assert!((p.tip.x - 10.0 * s).abs() < 1e-12);
+        }
+    }
+}
