@@ -19,6 +19,12 @@ Exit codes:
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
+    /// Errors only on stderr: no summaries, warnings or notes (the exit code still tells).
+    #[arg(short = 'q', long, global = true)]
+    pub quiet: bool,
+    /// More on stderr: the machine file, the rows and the rate, the run's time.
+    #[arg(short = 'v', long, global = true, conflicts_with = "quiet")]
+    pub verbose: bool,
 }
 
 #[derive(Debug, Subcommand)]
@@ -397,6 +403,9 @@ pub struct VerifyArgs {
     pub path: PathBuf,
     #[command(flatten)]
     pub part: PartArgs,
+    /// Write the text summary to FILE (`-`: stdout) instead of stderr.
+    #[arg(long, value_name = "FILE")]
+    pub summary: Option<PathBuf>,
     /// Machine file (TOML, or CSV with a `key,value` header); its [verify] table sets thresholds.
     /// Default: the embedded VERNE machine.
     #[arg(short = 'm', long = "machine", value_name = "FILE")]

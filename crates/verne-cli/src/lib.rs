@@ -11,17 +11,40 @@
 /// through it (or through `writeln!` with its result ignored).
 macro_rules! say {
     ($($arg:tt)*) => {{
-        use std::io::Write as _;
-        let _ = write!(std::io::stderr(), $($arg)*);
+        if $crate::verbosity() >= 1 {
+            use std::io::Write as _;
+            let _ = write!(std::io::stderr(), $($arg)*);
+        }
     }};
 }
 
 /// [`say!`] with a newline.
 macro_rules! sayln {
     ($($arg:tt)*) => {{
-        use std::io::Write as _;
-        let _ = writeln!(std::io::stderr(), $($arg)*);
+        if $crate::verbosity() >= 1 {
+            use std::io::Write as _;
+            let _ = writeln!(std::io::stderr(), $($arg)*);
+        }
     }};
+}
+
+/// [`sayln!`] only under `-v`.
+macro_rules! sayln_verbose {
+    ($($arg:tt)*) => {{
+        if $crate::verbosity() >= 2 {
+            use std::io::Write as _;
+            let _ = writeln!(std::io::stderr(), $($arg)*);
+        }
+    }};
+}
+
+/// How much goes to stderr besides errors: 0 nothing (`-q`), 1 summaries and warnings (the
+/// default), 2 also the machine, timings and rates (`-v`).
+static VERBOSITY: std::sync::atomic::AtomicU8 = std::sync::atomic::AtomicU8::new(1);
+
+/// The verbosity set by `-q`/`-v` ([`VERBOSITY`]).
+pub fn verbosity() -> u8 {
+    VERBOSITY.load(std::sync::atomic::Ordering::Relaxed)
 }
 
 pub mod arg_values;
@@ -62,6 +85,15 @@ pub fn run() -> ExitCode {
             });
         }
     };
+    VERBOSITY.store(
+        match (cli.quiet, cli.verbose) {
+            (true, _) => 0,
+            (false, true) => 2,
+            (false, false) => 1,
+        },
+        std::sync::atomic::Ordering::Relaxed,
+    );
+    let started = std::time::Instant::now();
     let result = match &cli.command {
         cli::Command::Ik(a) => cmd::ik::run(a),
         cli::Command::Fk(a) => cmd::fk::run(a),
@@ -74,12 +106,15 @@ pub fn run() -> ExitCode {
         cli::Command::Completions { shell } => cmd::shell::completions(*shell),
         cli::Command::Manpage => cmd::shell::manpage(),
     };
+    sayln_verbose!("verne: {:.3} s", started.elapsed().as_secs_f64());
     match result {
         Ok(code) => ExitCode::from(code),
         Err(e) if e.is_broken_pipe() => ExitCode::from(cmd::EXIT_OK),
         Err(e) => {
             table::remove_temp_files();
-            sayln!("verne: error: {e}");
+            // Errors are written whatever the verbosity.
+            use std::io::Write as _;
+            let _ = writeln!(std::io::stderr(), "verne: error: {e}");
             ExitCode::from(cmd::EXIT_FATAL)
         }
     }

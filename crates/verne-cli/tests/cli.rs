@@ -340,3 +340,66 @@ fn help_examples_run() {
     }
     assert!(ran >= 8, "{ran} examples");
 }
+
+#[test]
+fn quiet_verbose_and_the_summary_where_a_script_wants_it() {
+    // -q: nothing on stderr but errors; the exit code still tells.
+    let quiet = run(&["-q", "ik", "data/example.cl"], None);
+    assert_eq!(quiet.status.code(), Some(0));
+    assert!(
+        quiet.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&quiet.stderr)
+    );
+    let normal = run(&["ik", "data/example.cl"], None);
+    assert_eq!(quiet.stdout, normal.stdout, "-q changes only stderr");
+    let failed = run(&["ik", "-q", "tests/data/cl-corpus/nx_axis_zero.cls"], None);
+    assert_eq!(failed.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&failed.stderr).starts_with("verne: error: "));
+    // -v: the machine, the rows and their rate, the time.
+    let verbose = run(&["ik", "-v", "data/example.cl"], None);
+    let e = String::from_utf8_lossy(&verbose.stderr);
+    assert!(
+        e.contains("machine `VERNE` from the embedded default"),
+        "{e}"
+    );
+    assert!(e.contains("181 rows in, 181 rows out, 181 ok"), "{e}");
+    assert_eq!(
+        run(&["-q", "-v", "ik", "data/example.cl"], None)
+            .status
+            .code(),
+        Some(2)
+    );
+    // verify --summary -: the text summary on stdout, nothing on stderr with -q.
+    let v = run(
+        &[
+            "verify",
+            "-q",
+            "--joints",
+            "data/example-post.ngc",
+            "--path",
+            "data/example-tcp.ngc",
+            "--summary",
+            "-",
+        ],
+        None,
+    );
+    assert_eq!(v.status.code(), Some(0));
+    assert!(v.stderr.is_empty());
+    assert!(String::from_utf8_lossy(&v.stdout).contains(": clean"));
+    let both = run(
+        &[
+            "verify",
+            "--joints",
+            "data/example-post.ngc",
+            "--path",
+            "data/example-tcp.ngc",
+            "--summary",
+            "-",
+            "--format",
+            "json",
+        ],
+        None,
+    );
+    assert_eq!(both.status.code(), Some(2));
+}

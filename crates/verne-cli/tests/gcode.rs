@@ -333,4 +333,14 @@ fn ik_reports_where_the_joints_went() {
         "{line}"
     );
     assert!(line.contains("margins"), "{line}");
+    let flagged = rows
+        .iter()
+        .filter(|r| r[col(&h, "flags")].contains("near_rotary_singularity"))
+        .count();
+    assert!(
+        line.ends_with(&format!(
+            "; {flagged} rows near the rotary-axis singularity"
+        )),
+        "{line}"
+    );
 }

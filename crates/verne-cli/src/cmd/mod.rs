@@ -30,6 +30,18 @@ pub const EXIT_FATAL: u8 = 2;
 
 /// Loads `-m FILE`, or the embedded VERNE machine.
 pub fn load_machine(path: Option<&Path>) -> Result<Machine, VerneError> {
+    let machine = read_machine(path)?;
+    sayln_verbose!(
+        "verne: machine `{}` from {}",
+        machine.name,
+        path.map_or("the embedded default".to_string(), |p| p
+            .display()
+            .to_string())
+    );
+    Ok(machine)
+}
+
+fn read_machine(path: Option<&Path>) -> Result<Machine, VerneError> {
     match path {
         None => Ok(Machine::default_verne()),
         Some(p) if !p.exists() && p.as_os_str() == "verne" => Ok(Machine::default_verne()),
@@ -95,6 +107,7 @@ pub fn run_rows<J: RowJob>(
             b.set_position(n);
         }
     };
+    let started = std::time::Instant::now();
     let result = pipeline::run(job, &mut source, &mut sink, units, &tick);
     if let Some(b) = &bar {
         b.finish_and_clear();
@@ -108,6 +121,15 @@ pub fn run_rows<J: RowJob>(
     };
     sink.finish()?;
     report(command, source.name(), &summary);
+    let seconds = started.elapsed().as_secs_f64();
+    sayln_verbose!(
+        "verne {command}: {}: {} rows in, {} rows out, {} ok, in {seconds:.3} s ({:.0} rows/s)",
+        source.name(),
+        summary.input_rows,
+        summary.output_rows,
+        summary.ok_rows,
+        summary.input_rows as f64 / seconds.max(1e-9)
+    );
     Ok(if summary.all_ok() {
         EXIT_OK
     } else {

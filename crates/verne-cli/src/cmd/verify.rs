@@ -12,6 +12,12 @@ use super::{EXIT_OK, EXIT_ROWS_FAILED, load_machine, write_stdout};
 use crate::cli::{VerifyArgs, VerifyFormat};
 
 pub fn run(args: &VerifyArgs) -> Result<u8, VerneError> {
+    let summary_to_stdout = args.summary.as_ref().is_some_and(|p| p.as_os_str() == "-");
+    if summary_to_stdout && args.format == VerifyFormat::Json {
+        return Err(VerneError::Usage(
+            "--summary - and --format json both write stdout: give --summary a file".into(),
+        ));
+    }
     let machine = load_machine(args.machine.as_deref())?;
     let machine_name = args
         .machine
@@ -79,12 +85,21 @@ pub fn run(args: &VerifyArgs) -> Result<u8, VerneError> {
     if let Some((name, s)) = joints.gcode_summary() {
         crate::input::gcode::report_summary("verify", name, s);
     }
-    say!(
+    let text = format!(
         "verne verify: {} against {}: {}",
         args.joints.display(),
         args.path.display(),
         summary_text(&summary)
     );
+    match &args.summary {
+        None => say!("{text}"),
+        Some(p) if p.as_os_str() == "-" => write_stdout(&text)?,
+        Some(p) => {
+            let mut s = Sink::create(Some(p))?;
+            s.write_encoded(text.as_bytes())?;
+            s.finish()?;
+        }
+    }
     if args.format == VerifyFormat::Json {
         write_stdout(&format!("{}\n", summary_json(&summary)))?;
     }

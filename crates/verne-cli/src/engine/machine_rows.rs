@@ -68,6 +68,8 @@ pub struct JointTravel {
     pub max: [f64; 5],
     /// Sum of |change of theta2| from row to row (rad).
     pub theta2_travel: f64,
+    /// Rows flagged `near_rotary_singularity` (the tool axis near the rotary axis).
+    pub near_rotary_singularity: u64,
     last_theta2: Option<f64>,
 }
 
@@ -117,9 +119,10 @@ impl JointTravel {
             self.theta2_travel / std::f64::consts::TAU
         ));
         format!(
-            "joint travel over {} ok rows: {}",
+            "joint travel over {} ok rows: {}; {} rows near the rotary-axis singularity",
             self.rows,
-            parts.join(", ")
+            parts.join(", "),
+            self.near_rotary_singularity
         )
     }
 }
@@ -288,6 +291,7 @@ impl RowJob for MachineIk {
             Ok(row) => {
                 self.travel
                     .add([row.rho.x, row.rho.y, row.rho.z, row.theta1, row.theta2]);
+                self.travel.near_rotary_singularity += u64::from(row.near_rotary_singularity);
                 let flags = match (row.near_rotary_singularity, row.switched) {
                     (true, true) => "near_rotary_singularity;orientation_switch",
                     (true, false) => "near_rotary_singularity",

@@ -174,6 +174,9 @@ fn open_cl_file(path: &Path, name: &str, options: Options) -> Result<PathInput, 
 /// `tool_length` is the length the joints were computed with: a tool length the file gives
 /// (NX `TLDATA`) that differs from it is a warning, since it is not applied.
 pub fn report_summary(cmd: &str, name: &str, s: &Summary, tool_length: f64) {
+    if crate::verbosity() == 0 {
+        return;
+    }
     let mut err = std::io::stderr().lock();
     for w in &s.warnings {
         let _ = writeln!(err, "verne {cmd}: {name}: warning: {w}");

@@ -58,6 +58,9 @@ fn axis_of(letter: char) -> Axis {
 
 /// Prints what the reader saw besides the rows to stderr, prefixed `verne CMD: NAME:`.
 pub fn report_summary(cmd: &str, name: &str, s: &Summary) {
+    if crate::verbosity() == 0 {
+        return;
+    }
     let mut err = std::io::stderr().lock();
     for w in &s.warnings {
         let _ = writeln!(err, "verne {cmd}: {name}: warning: {w}");
