@@ -598,7 +598,12 @@ pub fn format_number(out: &mut Vec<u8>, v: f64, decimals: Option<usize>) {
             out.extend_from_slice(s.as_bytes());
         }
         Some(d) => {
+            let start = out.len();
             let _ = write!(out, "{v:.d$}");
+            // A small negative number rounds to "-0.000": written "0.000", as -0 is "0".
+            if out[start] == b'-' && out[start + 1..].iter().all(|&b| b == b'0' || b == b'.') {
+                out.remove(start);
+            }
         }
     }
 }

@@ -403,3 +403,27 @@ fn quiet_verbose_and_the_summary_where_a_script_wants_it() {
     );
     assert_eq!(both.status.code(), Some(2));
 }
+
+#[test]
+fn command_line_poses_are_counted_from_one_and_zero_has_no_sign() {
+    let out = run(
+        &["ik", "--tool", "10,-20,80,0,0,1", "--tool", "1e9,0,0,0,0,1"],
+        None,
+    );
+    assert_eq!(out.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(e.contains("<command line>: pose 2: unreachable"), "{e}");
+    // fk of the home pose writes y and phi1 near zero: never "-0.000".
+    let out = run(
+        &[
+            "fk",
+            "--precision",
+            "3",
+            "--machine-joints",
+            "314.1247,260.7776,260.5964,0,0",
+        ],
+        None,
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("0.000") && !text.contains("-0.000"), "{text}");
+}

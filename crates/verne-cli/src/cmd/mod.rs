@@ -82,9 +82,12 @@ pub fn inline_source(header: &str, rows: &[Vec<f64>]) -> Result<CsvSource, Verne
     }
     CsvSource::from_reader(
         Box::new(std::io::Cursor::new(text.into_bytes())),
-        "<command line>",
+        INLINE_SOURCE,
     )
 }
+
+/// The name of the rows given on the command line (`--pose`, `--tool`, `--joints`, ...).
+pub const INLINE_SOURCE: &str = "<command line>";
 
 /// Runs a row job from `source` to `output`, with a progress indicator on a terminal, and
 /// prints the summary of rows that were not ok to stderr.
@@ -164,7 +167,12 @@ fn report(command: &str, file: &str, s: &RunSummary) {
         counts.join(", ")
     );
     for (line, st) in &s.first_failures {
-        sayln!("  {file}:{line}: {st}");
+        if file == INLINE_SOURCE {
+            // Line 1 of the inline table is its header: the first pose is on line 2.
+            sayln!("  {file}: pose {}: {st}", line.saturating_sub(1));
+        } else {
+            sayln!("  {file}:{line}: {st}");
+        }
     }
 }
 
