@@ -22,6 +22,27 @@ pub fn parse_triple(s: &str) -> Result<[f64; 3], String> {
     Ok(out)
 }
 
+/// Parses a point of either mechanism: `X,Y,Z` (the VERNE machine) or `X,Y` (a planar glider;
+/// the third value is then NaN, which the VERNE commands refuse with [`spatial`]).
+pub fn parse_point(s: &str) -> Result<[f64; 3], String> {
+    if s.split(',').count() == 2 {
+        let two = parse_numbers::<2>(s, "numbers")?;
+        return Ok([two[0], two[1], f64::NAN]);
+    }
+    parse_triple(s)
+}
+
+/// The points given for the VERNE machine: three values each.
+pub fn spatial(points: &[[f64; 3]], flag: &str, names: &str) -> Result<(), String> {
+    match points.iter().find(|p| p[2].is_nan()) {
+        Some(p) => Err(format!(
+            "{flag} {},{}: the VERNE machine needs {names} (two values are a glider's planar point: -m biglide1|biglide2|orthoglide or a glider file)",
+            p[0], p[1]
+        )),
+        None => Ok(()),
+    }
+}
+
 pub fn parse_numbers<const N: usize>(s: &str, what: &str) -> Result<[f64; N], String> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
     if parts.len() != N {

@@ -111,7 +111,7 @@ pub struct IkArgs {
     pub input_format: Option<InputFormat>,
     /// One platform point XP,YP,ZP instead of an input file (repeatable). Use
     /// `--pose=-240,-86,1000` for negative values.
-    #[arg(long, value_name = "XP,YP,ZP", value_parser = parse_triple, conflicts_with_all = ["input", "tool"])]
+    #[arg(long, value_name = "XP,YP,ZP", value_parser = parse_point, conflicts_with_all = ["input", "tool"])]
     pub pose: Vec<[f64; 3]>,
     /// One tool pose X,Y,Z,I,J,K (tip in mm and tool axis, workpiece frame) instead of an input
     /// file (repeatable; rows of one path).
@@ -153,7 +153,7 @@ pub struct FkArgs {
     #[arg(value_name = "INPUT")]
     pub input: Option<PathBuf>,
     /// One set of slider positions R1,R2,R3 instead of an input file (repeatable).
-    #[arg(long, value_name = "R1,R2,R3", value_parser = parse_triple, conflicts_with_all = ["input", "machine_joints"])]
+    #[arg(long, value_name = "R1,R2,R3", value_parser = parse_point, conflicts_with_all = ["input", "machine_joints"])]
     pub joints: Vec<[f64; 3]>,
     /// One set of machine joints RHO1,RHO2,RHO3,THETA1,THETA2 instead of an input file
     /// (repeatable).
@@ -179,10 +179,10 @@ pub struct FkArgs {
 #[derive(Debug, Args)]
 pub struct ModesArgs {
     /// A platform point XP,YP,ZP: every inverse branch.
-    #[arg(long, value_name = "XP,YP,ZP", value_parser = parse_triple, required_unless_present = "joints", conflicts_with = "joints")]
+    #[arg(long, value_name = "XP,YP,ZP", value_parser = parse_point, required_unless_present = "joints", conflicts_with = "joints")]
     pub pose: Option<[f64; 3]>,
     /// Slider positions R1,R2,R3: every assembly mode.
-    #[arg(long, value_name = "R1,R2,R3", value_parser = parse_triple)]
+    #[arg(long, value_name = "R1,R2,R3", value_parser = parse_point)]
     pub joints: Option<[f64; 3]>,
     /// CSV for a script instead of an aligned table.
     #[arg(long)]

@@ -412,7 +412,7 @@ fn command_line_poses_are_counted_from_one_and_zero_has_no_sign() {
     );
     assert_eq!(out.status.code(), Some(1));
     let e = String::from_utf8_lossy(&out.stderr);
-    assert!(e.contains("<command line>: pose 2: unreachable"), "{e}");
+    assert!(e.contains("<command line>: row 2: unreachable"), "{e}");
     // fk of the home pose writes y and phi1 near zero: never "-0.000".
     let out = run(
         &[

@@ -268,7 +268,7 @@ fn exit_codes_follow_the_contract() {
     // 2: a non-zero third value, a missing column, a malformed cell.
     let planar = run(&["ik", "-m", "biglide2", "--pose", "1,2,3"], None);
     assert_eq!(planar.status.code(), Some(2));
-    assert!(stderr(&planar).contains("the third value must be 0"));
+    assert!(stderr(&planar).contains("a third value must be 0"));
     let missing = run(&["ik", "-m", "biglide2"], Some("xp,yp\n1,2\n"));
     assert_eq!(missing.status.code(), Some(2));
     assert!(stderr(&missing).contains("missing column"));
@@ -462,4 +462,49 @@ fn design_for_a_person_and_for_other_bounds() {
     // Bad bounds are a usage error.
     let bad = run(&["design", "--bounds", "3,1"], None);
     assert_eq!(bad.status.code(), Some(2));
+}
+
+#[test]
+fn the_mechanism_is_resolved_once_and_its_options_checked() {
+    let stderr = |o: &std::process::Output| String::from_utf8_lossy(&o.stderr).into_owned();
+    // machine check knows glider files.
+    let c = run(&["machine", "check", "data/biglide1.toml"], None);
+    assert_eq!(c.status.code(), Some(0), "{}", stderr(&c));
+    assert!(String::from_utf8_lossy(&c.stdout).contains("valid glider `biglide1`"));
+    // selftest refuses a glider clearly (not "No such file").
+    let s = run(&["selftest", "-m", "biglide1"], None);
+    assert_eq!(s.status.code(), Some(2));
+    assert!(stderr(&s).contains("planar glider"), "{}", stderr(&s));
+    // Options of the VERNE machine are refused for a glider, not ignored.
+    let t = run(&["ik", "-m", "orthoglide", "--tool", "1,2,3,0,0,1"], None);
+    assert_eq!(t.status.code(), Some(2));
+    assert!(
+        stderr(&t).contains("--tool is an option for the VERNE machine"),
+        "{}",
+        stderr(&t)
+    );
+    let f = run(
+        &[
+            "fk",
+            "-m",
+            "biglide2",
+            "--joints",
+            "0.5,0.6",
+            "--tool-length",
+            "10",
+        ],
+        None,
+    );
+    assert_eq!(f.status.code(), Some(2));
+    assert!(stderr(&f).contains("--tool-length"), "{}", stderr(&f));
+    // Planar points take two values; the VERNE machine refuses two.
+    let two = run(&["ik", "-m", "biglide1", "--pose", "0.98,0.5"], None);
+    let three = run(&["ik", "-m", "biglide1", "--pose", "0.98,0.5,0"], None);
+    assert_eq!(two.status.code(), Some(0), "{}", stderr(&two));
+    assert_eq!(two.stdout, three.stdout);
+    let m = run(&["modes", "-m", "biglide1", "--joints", "0.5,0.6"], None);
+    assert_eq!(m.status.code(), Some(0), "{}", stderr(&m));
+    let v = run(&["ik", "--pose", "1,2"], None);
+    assert_eq!(v.status.code(), Some(2));
+    assert!(stderr(&v).contains("needs XP,YP,ZP"), "{}", stderr(&v));
 }

@@ -272,3 +272,33 @@ fn machine_fk_all_lists_assembly_modes_with_one_working() {
     assert!((num(&w[col(&h, "x")]) - 10.0).abs() < TIP_TOL_MM);
     assert!((num(&w[col(&h, "z")]) - 40.0).abs() < TIP_TOL_MM);
 }
+
+#[test]
+fn machine_check_checks_the_verify_thresholds_too() {
+    let base = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../data/verne.toml"
+    ))
+    .unwrap();
+    let dir = std::env::temp_dir().join(format!("verne-machine-check-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (name, table, expect) in [
+        (
+            "bogus.toml",
+            "[verify]\nbogus = 1\n",
+            "unknown threshold `bogus`",
+        ),
+        (
+            "negative.toml",
+            "[verify]\ntip_error_mm = -1\n",
+            "must be a positive number",
+        ),
+    ] {
+        let path = dir.join(name);
+        std::fs::write(&path, format!("{base}\n{table}")).unwrap();
+        let out = run(&["machine", "check", path.to_str().unwrap()], None);
+        assert_eq!(out.status.code(), Some(2), "{name}");
+        let e = String::from_utf8_lossy(&out.stderr);
+        assert!(e.contains(expect) && e.contains("verify."), "{name}: {e}");
+    }
+}

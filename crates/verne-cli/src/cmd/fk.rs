@@ -6,14 +6,25 @@ use crate::engine::module_rows::{ModuleFkAll, ModuleFkWorking};
 use crate::error::VerneError;
 use crate::table::CsvSource;
 
-use super::{inline_source, load_machine, run_rows, units};
+use super::{Mechanism, inline_source, load_mechanism, refuse_for_glider, run_rows, units};
 use crate::cli::FkArgs;
 
 pub fn run(args: &FkArgs) -> Result<u8, VerneError> {
-    if let Some(spec) = super::glider::load(args.common.machine.as_deref())? {
-        return super::glider::fk(args, spec);
-    }
-    let machine = load_machine(args.common.machine.as_deref())?;
+    let machine = match load_mechanism(args.common.machine.as_deref())? {
+        Mechanism::Glider(spec) => {
+            refuse_for_glider(
+                &spec.name,
+                &[
+                    ("--machine-joints", !args.machine_joints.is_empty()),
+                    ("--tool-length", args.tool_length.is_some()),
+                    ("--offset", args.offset.is_some()),
+                ],
+            )?;
+            return super::glider::fk(args, spec);
+        }
+        Mechanism::Verne(m) => m,
+    };
+    crate::arg_values::spatial(&args.joints, "--joints", "R1,R2,R3").map_err(VerneError::Usage)?;
     let u = units(&args.common);
     let source = if !args.joints.is_empty() {
         inline_source(

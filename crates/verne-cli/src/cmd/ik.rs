@@ -7,7 +7,7 @@ use crate::error::VerneError;
 use crate::table::CsvSource;
 use verne::machine::FirstRowChoice;
 
-use super::{inline_source, load_machine, run_rows, units};
+use super::{Mechanism, inline_source, load_mechanism, refuse_for_glider, run_rows, units};
 use crate::cli::{IkArgs, OutputFormat, Prefer};
 use crate::input::as_csv::AsCsv;
 use crate::input::cl::{ClAsCsv, ClRows, PathInput, open_path_input, report_summary};
@@ -15,10 +15,25 @@ use crate::input::gcode::{TcpAsCsv, TcpRows};
 use crate::input::resample::Resampler;
 
 pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
-    if let Some(spec) = super::glider::load(args.common.machine.as_deref())? {
-        return super::glider::ik(args, spec);
-    }
-    let machine = load_machine(args.common.machine.as_deref())?;
+    let machine = match load_mechanism(args.common.machine.as_deref())? {
+        Mechanism::Glider(spec) => {
+            refuse_for_glider(
+                &spec.name,
+                &[
+                    ("--tool", !args.tool.is_empty()),
+                    ("--tool-length", args.tool_length.is_some()),
+                    ("--prefer", args.prefer != Prefer::SmallestTheta1),
+                    ("--format", args.format != OutputFormat::Csv),
+                    ("--period", args.period.is_some()),
+                    ("--units", args.part.units.is_some()),
+                    ("--offset", args.part.offset.is_some()),
+                    ("--input-format", args.input_format.is_some()),
+                ],
+            )?;
+            return super::glider::ik(args, spec);
+        }
+        Mechanism::Verne(m) => m,
+    };
     let mut u = units(&args.common);
     u.halstreamer = args.format == OutputFormat::Halstreamer;
     if args.format == OutputFormat::Gcode {
@@ -43,6 +58,7 @@ pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
     let mut cl_summary = None;
     let mut gcode_summary = None;
     let mut travel = None;
+    crate::arg_values::spatial(&args.pose, "--pose", "XP,YP,ZP").map_err(VerneError::Usage)?;
     let source = if !args.pose.is_empty() {
         inline_source(
             "xp,yp,zp",

@@ -3,8 +3,9 @@
 use crate::error::VerneError;
 use verne::spec::DEFAULT_MACHINE_TOML;
 
-use super::{EXIT_OK, load_machine, write_stdout};
+use super::{EXIT_OK, Mechanism, load_mechanism, write_stdout};
 use crate::cli::MachineCommand;
+use verne::verify::Thresholds;
 
 pub fn run(cmd: &MachineCommand) -> Result<u8, VerneError> {
     match cmd {
@@ -13,8 +14,20 @@ pub fn run(cmd: &MachineCommand) -> Result<u8, VerneError> {
             Ok(EXIT_OK)
         }
         MachineCommand::Check { file } => {
-            let m = load_machine(Some(file))?;
-            write_stdout(&format!("{}: valid machine `{}`\n", file.display(), m.name))?;
+            let name = file.display().to_string();
+            match load_mechanism(Some(file))? {
+                Mechanism::Verne(m) => {
+                    // The [verify] thresholds too: a file that verify would refuse is not valid.
+                    let thresholds = Thresholds::from_machine(&m, &name)?;
+                    thresholds
+                        .check()
+                        .map_err(|e| VerneError::input(&name, None, Some("verify"), e))?;
+                    write_stdout(&format!("{name}: valid machine `{}`\n", m.name))?;
+                }
+                Mechanism::Glider(g) => {
+                    write_stdout(&format!("{name}: valid glider `{}`\n", g.name))?;
+                }
+            }
             Ok(EXIT_OK)
         }
     }

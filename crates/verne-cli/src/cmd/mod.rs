@@ -28,6 +28,45 @@ pub const EXIT_OK: u8 = 0;
 pub const EXIT_ROWS_FAILED: u8 = 1;
 pub const EXIT_FATAL: u8 = 2;
 
+/// The mechanism a command runs on: the VERNE machine (a machine file) or a planar glider (a
+/// preset name or a glider file), decided once from `-m` (ARCHITECTURE.md).
+#[allow(clippy::large_enum_variant)] // one per run
+pub enum Mechanism {
+    Verne(Machine),
+    Glider(verne::glider::GliderSpec),
+}
+
+/// Loads `-m`: a preset name (`verne`, `biglide1`, `biglide2`, `orthoglide`), a glider file
+/// (`kind = "glider"`) or a VERNE machine file; the embedded VERNE machine without `-m`.
+pub fn load_mechanism(path: Option<&Path>) -> Result<Mechanism, VerneError> {
+    if let Some(spec) = glider::load(path)? {
+        sayln_verbose!("verne: glider `{}`", spec.name);
+        return Ok(Mechanism::Glider(spec));
+    }
+    load_machine(path).map(Mechanism::Verne)
+}
+
+/// Refuses the options that a glider does not have, naming them: `what` lists (option, given).
+pub fn refuse_for_glider(glider: &str, options: &[(&str, bool)]) -> Result<(), VerneError> {
+    let given: Vec<&str> = options
+        .iter()
+        .filter(|(_, g)| *g)
+        .map(|(o, _)| *o)
+        .collect();
+    if given.is_empty() {
+        return Ok(());
+    }
+    Err(VerneError::Usage(format!(
+        "{} {} for the VERNE machine; `{glider}` is a planar glider (its poses are --pose X,Y, its joints --joints RHO1,RHO2; docs/gliders.md)",
+        given.join(", "),
+        if given.len() == 1 {
+            "is an option"
+        } else {
+            "are options"
+        }
+    )))
+}
+
 /// Loads `-m FILE`, or the embedded VERNE machine.
 pub fn load_machine(path: Option<&Path>) -> Result<Machine, VerneError> {
     let machine = read_machine(path)?;
@@ -169,7 +208,7 @@ fn report(command: &str, file: &str, s: &RunSummary) {
     for (line, st) in &s.first_failures {
         if file == INLINE_SOURCE {
             // Line 1 of the inline table is its header: the first pose is on line 2.
-            sayln!("  {file}: pose {}: {st}", line.saturating_sub(1));
+            sayln!("  {file}: row {}: {st}", line.saturating_sub(1));
         } else {
             sayln!("  {file}:{line}: {st}");
         }

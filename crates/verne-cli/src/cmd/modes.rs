@@ -29,6 +29,18 @@ pub fn run(args: &ModesArgs) -> Result<u8, VerneError> {
         return super::glider::modes(args, spec);
     }
     let machine = load_machine(args.common.machine.as_deref())?;
+    let given: Vec<[f64; 3]> = args.pose.iter().chain(&args.joints).copied().collect();
+    let names = if args.pose.is_some() {
+        "XP,YP,ZP"
+    } else {
+        "R1,R2,R3"
+    };
+    let flag = if args.pose.is_some() {
+        "--pose"
+    } else {
+        "--joints"
+    };
+    crate::arg_values::spatial(&given, flag, names).map_err(VerneError::Usage)?;
     let u = units(&args.common);
     let (title, solutions) = query(&machine, args);
     let angle = if u.radians { "alpha_rad" } else { "alpha_deg" };

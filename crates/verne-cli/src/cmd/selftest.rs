@@ -4,11 +4,19 @@
 use crate::error::VerneError;
 use verne::selftest;
 
-use super::{EXIT_OK, EXIT_ROWS_FAILED, load_machine, write_stdout};
+use super::{EXIT_OK, EXIT_ROWS_FAILED, Mechanism, load_mechanism, write_stdout};
 use crate::cli::SelftestArgs;
 
 pub fn run(args: &SelftestArgs) -> Result<u8, VerneError> {
-    let machine = load_machine(args.machine.as_deref())?;
+    let machine = match load_mechanism(args.machine.as_deref())? {
+        Mechanism::Verne(m) => m,
+        Mechanism::Glider(spec) => {
+            return Err(VerneError::Usage(format!(
+                "selftest checks the VERNE machine's spatial solvers over its joint strokes; `{}` is a planar glider, whose closed-form kinematics are checked by `verne design` (Tables 1 and 2) and the test suite (docs/gliders.md)",
+                spec.name
+            )));
+        }
+    };
     let n = usize::from(args.grid);
     let start = std::time::Instant::now();
     let r = selftest::run(&machine, n);

@@ -35,19 +35,24 @@ const TABLE_DECIMALS: usize = 6;
 fn inline_planar(header: &str, flag: &str, rows: &[[f64; 3]]) -> Result<CsvSource, VerneError> {
     let mut text = format!("{header}\n");
     for r in rows {
-        if r[2] != 0.0 {
-            return Err(VerneError::Usage(format!(
-                "{flag} {},{},{}: a glider is planar; give {flag} A,B,0 (the third value must be \
-                 0, found {})",
-                r[0], r[1], r[2], r[2]
-            )));
-        }
+        planar(*r, flag)?;
         text.push_str(&format!("{},{}\n", r[0], r[1]));
     }
     CsvSource::from_reader(
         Box::new(std::io::Cursor::new(text.into_bytes())),
         "<command line>",
     )
+}
+
+/// A point given to a glider: `A,B` (or `A,B,0`).
+fn planar(v: [f64; 3], flag: &str) -> Result<(), VerneError> {
+    if v[2] == 0.0 || v[2].is_nan() {
+        return Ok(());
+    }
+    Err(VerneError::Usage(format!(
+        "{flag} {},{},{}: a glider is planar; give {flag} A,B (a third value must be 0, found {})",
+        v[0], v[1], v[2], v[2]
+    )))
 }
 
 /// The glider named by `-m`: a preset name (when no file of that name exists) or a file whose
@@ -60,16 +65,24 @@ pub fn load(machine: Option<&Path>) -> Result<Option<GliderSpec>, VerneError> {
     let name = p.display().to_string();
     let bytes = crate::table::read_input_file(p).map_err(|e| VerneError::io(&name, e))?;
     let text = String::from_utf8_lossy(&bytes);
-    let is_glider = text.lines().any(|l| {
-        let l = l.trim().replace(' ', "");
-        l == "kind=\"glider\"" || l == "kind,glider"
-    });
-    if !is_glider {
+    if !is_glider_text(&text) {
         return Ok(None);
     }
-    GliderSpec::from_toml_str(&text, &name)
-        .map(Some)
-        .map_err(|e| VerneError::input(&name, None, None, e.to_string()))
+    glider_from_text(&text, &name).map(Some)
+}
+
+/// The file says `kind = "glider"` (TOML) or `kind,glider` (CSV).
+pub fn is_glider_text(text: &str) -> bool {
+    text.lines().any(|l| {
+        let l = l.trim().replace(' ', "");
+        l == "kind=\"glider\"" || l == "kind,glider"
+    })
+}
+
+/// A glider file's text as a glider, or the error with the file's name.
+pub fn glider_from_text(text: &str, name: &str) -> Result<GliderSpec, VerneError> {
+    GliderSpec::from_toml_str(text, name)
+        .map_err(|e| VerneError::input(name, None, None, e.to_string()))
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -175,17 +188,7 @@ const KINETOSTATIC_HEADER: [&str; 7] = [
 /// singularity flags and amplification factors.
 pub fn modes(args: &ModesArgs, spec: GliderSpec) -> Result<u8, VerneError> {
     let u = units(&args.common);
-    let third = |v: [f64; 3], flag: &str| {
-        if v[2] == 0.0 {
-            Ok(())
-        } else {
-            Err(VerneError::Usage(format!(
-                "{flag} {},{},{}: a glider is planar; give {flag} A,B,0 (the third value must be \
-                 0, found {})",
-                v[0], v[1], v[2], v[2]
-            )))
-        }
-    };
+    let third = planar;
     let mut header: Vec<&str>;
     let mut rows: Vec<Vec<Cell>> = Vec::new();
     let title;
