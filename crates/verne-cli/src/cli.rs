@@ -196,12 +196,18 @@ pub struct ModesArgs {
 
 #[derive(Debug, Subcommand)]
 pub enum MachineCommand {
-    /// Print the default machine file (a template to edit).
-    Show,
-    /// Validate a machine file and report every problem.
+    /// Print the default machine file (a template to edit), or a preset.
+    Show {
+        /// The preset: verne (default), biglide1, biglide2, orthoglide. A file of your own
+        /// can start from one with `base = "verne"` and give only the keys it changes.
+        #[arg(long, value_name = "NAME", default_value = "verne")]
+        base: String,
+    },
+    /// Validate machine files and report every problem of each.
     Check {
-        /// The machine file (TOML or key,value CSV).
-        file: PathBuf,
+        /// The machine files (TOML or key,value CSV; VERNE machines or gliders).
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
     },
 }
 

@@ -302,3 +302,73 @@ fn machine_check_checks_the_verify_thresholds_too() {
         assert!(e.contains(expect) && e.contains("verify."), "{name}: {e}");
     }
 }
+
+#[test]
+fn machine_files_on_a_base_presets_and_several_checks() {
+    let dir = std::env::temp_dir().join(format!("verne-machine-base-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("shop.toml"),
+        "base = \"verne\"\nname = \"shop\"\n[tool]\nlength = 120\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("job.toml"),
+        "base = \"shop.toml\"\nname = \"job\"\n[limits]\nrho1_max = 900\n",
+    )
+    .unwrap();
+    std::fs::write(dir.join("broken.toml"), "base = \"missing.toml\"\n").unwrap();
+    let p = |n: &str| dir.join(n).to_str().unwrap().to_string();
+    // The job's joints are those of the default machine with a 120 mm tool.
+    let job = run(
+        &["ik", "-m", &p("job.toml"), "--tool", "10,-20,80,0,0,1"],
+        None,
+    );
+    let long = run(
+        &["ik", "--tool-length", "120", "--tool", "10,-20,80,0,0,1"],
+        None,
+    );
+    assert_eq!(job.status.code(), Some(0));
+    assert_eq!(job.stdout, long.stdout);
+    // Several files: each one's verdict, exit 2 if any is invalid.
+    let c = run(
+        &[
+            "machine",
+            "check",
+            &p("shop.toml"),
+            &p("job.toml"),
+            "data/orthoglide.toml",
+            &p("broken.toml"),
+        ],
+        None,
+    );
+    assert_eq!(c.status.code(), Some(2));
+    let out = String::from_utf8_lossy(&c.stdout);
+    assert!(
+        out.contains("valid machine `shop`")
+            && out.contains("valid machine `job`")
+            && out.contains("valid glider `orthoglide`"),
+        "{out}"
+    );
+    let e = String::from_utf8_lossy(&c.stderr);
+    assert!(
+        e.contains("broken.toml:1: base") && e.contains("missing.toml"),
+        "{e}"
+    );
+    // Presets.
+    let g = run(&["machine", "show", "--base", "biglide2"], None);
+    assert_eq!(g.status.code(), Some(0));
+    let text = String::from_utf8_lossy(&g.stdout);
+    assert!(
+        text.contains("kind = \"glider\"") && text.contains("biglide2"),
+        "{text}"
+    );
+    std::fs::write(dir.join("b2.toml"), g.stdout).unwrap();
+    let again = run(&["machine", "check", &p("b2.toml")], None);
+    assert_eq!(
+        again.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&again.stderr)
+    );
+}

@@ -97,7 +97,18 @@ fn read_machine(path: Option<&Path>) -> Result<Machine, VerneError> {
                     "not UTF-8 text; expected a TOML or key,value CSV machine file",
                 )
             })?;
-            Ok(Machine::from_str_auto(&text, &name)?)
+            // A base named by path is read relative to this file's folder.
+            let dir = p.parent().map(Path::to_path_buf).unwrap_or_default();
+            let resolve = |base: &str| -> Result<(String, String), String> {
+                let path = dir.join(base);
+                let shown = path.display().to_string();
+                let bytes = crate::table::read_input_file(&path)
+                    .map_err(|e| format!("base {shown}: {e}"))?;
+                String::from_utf8(bytes)
+                    .map(|t| (t, shown.clone()))
+                    .map_err(|_| format!("base {shown}: not UTF-8 text"))
+            };
+            Ok(Machine::from_str_on_base(&text, &name, Some(&resolve))?)
         }
     }
 }

@@ -150,27 +150,39 @@ const SCHEMA: &[(&str, &str, Check, &str)] = &[
     ("tool", "length", Check::Finite, "tool length Delta (mm)"),
 ];
 
-const TOP_LEVEL_KEYS: &[&str] = &["kind", "name"];
+const TOP_LEVEL_KEYS: &[&str] = &["kind", "name", "base"];
 
 impl Machine {
     /// Parses a machine file, choosing the format from its content: a first non-comment line
     /// `key,value` means CSV, anything else TOML.
     pub fn from_str_auto(text: &str, source: &str) -> Result<Machine, MachineError> {
-        let first = text
-            .trim_start_matches('\u{feff}')
-            .lines()
-            .map(str::trim)
-            .find(|l| !l.is_empty() && !l.starts_with('#'));
-        match first {
-            Some(l) if l.replace(' ', "").eq_ignore_ascii_case("key,value") => {
-                Machine::from_csv_str(text, source)
-            }
-            _ => Machine::from_toml_str(text, source),
-        }
+        Machine::from_str_on_base(text, source, None)
     }
 
-    /// Parses and validates a TOML machine file.
+    /// Parses and validates a TOML machine file. A file may start from a base, `base = "verne"`
+    /// (the embedded default machine), and give only the keys it changes; a base given by a
+    /// path is read by the caller ([`Machine::from_str_on_base`]).
     pub fn from_toml_str(text: &str, source: &str) -> Result<Machine, MachineError> {
+        Machine::from_str_on_base(text, source, None)
+    }
+
+    /// Parses a machine file (TOML or key,value CSV) over the base it names, if any: every key
+    /// of the base, then the file's keys in place of the base's. `resolve` turns a base's name
+    /// into its text and a name for messages (the command line tool reads paths); `verne` is
+    /// always the embedded default. A base may name its own base, up to
+    /// [`MAX_BASE_DEPTH`] files.
+    pub fn from_str_on_base(
+        text: &str,
+        source: &str,
+        resolve: Option<&BaseResolver<'_>>,
+    ) -> Result<Machine, MachineError> {
+        let (entries, problems) = entries_over_base(text, source, resolve, 0)?;
+        finish(entries, problems, source)
+    }
+
+    /// The entries of a TOML machine file (dotted keys with their lines), and the problems of
+    /// its sections; an error when it is not TOML.
+    fn toml_entries(text: &str, source: &str) -> Result<(Vec<Entry>, Vec<Problem>), MachineError> {
         let text = text.trim_start_matches('\u{feff}');
         let table: toml::Table = match text.parse() {
             Ok(t) => t,
@@ -215,11 +227,17 @@ impl Machine {
             }
         }
         problems.extend(check_sections(&table, &lines));
-        finish(entries, problems, source)
+        Ok((entries, problems))
     }
 
-    /// Parses and validates a two-column CSV machine file (`key,value` header, dotted keys).
+    /// Parses and validates a two-column CSV machine file (`key,value` header, dotted keys),
+    /// over the base it names, if any.
     pub fn from_csv_str(text: &str, source: &str) -> Result<Machine, MachineError> {
+        Machine::from_str_on_base(text, source, None)
+    }
+
+    /// The entries of a key,value CSV machine file, with their lines, and its problems.
+    fn csv_entries(text: &str) -> (Vec<Entry>, Vec<Problem>) {
         let mut entries = Vec::new();
         let mut problems = Vec::new();
         let mut seen_header = false;
@@ -252,7 +270,7 @@ impl Machine {
                 line: Some(line_no),
             });
         }
-        finish(entries, problems, source)
+        (entries, problems)
     }
 
     /// Validates the machine as a whole (what the schema of single keys cannot see).
@@ -408,6 +426,92 @@ fn toml_value(v: &toml::Value) -> Value {
         toml::Value::Datetime(_) => Value::Other("a date"),
         toml::Value::Array(_) => Value::Other("an array"),
         toml::Value::Table(_) => Value::Other("a table"),
+    }
+}
+
+/// Turns a base's name into its text and a name for messages, or says why it cannot.
+pub type BaseResolver<'a> = dyn Fn(&str) -> Result<(String, String), String> + 'a;
+
+/// Most files in a chain of bases (a file, its base, the base's base, ...).
+pub const MAX_BASE_DEPTH: usize = 8;
+
+/// The entries of a machine file with its base's merged under them (see
+/// [`Machine::from_str_on_base`]).
+fn entries_over_base(
+    text: &str,
+    source: &str,
+    resolve: Option<&BaseResolver<'_>>,
+    depth: usize,
+) -> Result<(Vec<Entry>, Vec<Problem>), MachineError> {
+    let (mut entries, problems) = entries_of(text, source)?;
+    let Some(i) = entries.iter().position(|e| e.key == "base") else {
+        return Ok((entries, problems));
+    };
+    let e = entries.remove(i);
+    // A base that cannot be used is the one problem reported: the keys it would have given
+    // are not missing from this file.
+    let fail = |message: String| MachineError {
+        source: source.to_string(),
+        problems: vec![Problem {
+            line: e.line,
+            key: "base".into(),
+            message,
+        }],
+    };
+    let Value::Text(name) = &e.value else {
+        return Err(fail(
+            "expected a string: \"verne\" or the path of a machine file".into(),
+        ));
+    };
+    if depth + 1 >= MAX_BASE_DEPTH {
+        return Err(fail(format!(
+            "more than {MAX_BASE_DEPTH} files in the chain of bases (a cycle?)"
+        )));
+    }
+    let resolved = match (name.as_str(), resolve) {
+        ("verne", _) => Ok((
+            super::DEFAULT_MACHINE_TOML.to_string(),
+            "the embedded default machine".to_string(),
+        )),
+        (_, Some(r)) => r(name),
+        (_, None) => Err(format!(
+            "base `{name}` is not known here: \"verne\" (the embedded default), or a path read by the command line tool"
+        )),
+    };
+    let (base_text, base_source) = resolved.map_err(fail)?;
+    // The base's own errors name the base's file and line.
+    let (base_entries, base_problems) =
+        entries_over_base(&base_text, &base_source, resolve, depth + 1)?;
+    if !base_problems.is_empty() {
+        return Err(MachineError {
+            source: base_source,
+            problems: base_problems,
+        });
+    }
+    // The base's keys (no line: they are not in this file), then this file's.
+    let own: HashSet<String> = entries.iter().map(|e| e.key.clone()).collect();
+    let mut merged: Vec<Entry> = base_entries
+        .into_iter()
+        .filter(|b| !own.contains(&b.key))
+        .map(|b| Entry { line: None, ..b })
+        .collect();
+    merged.append(&mut entries);
+    Ok((merged, problems))
+}
+
+/// The entries of a machine file in either format (the first non-comment line `key,value`
+/// means CSV), and the problems found while reading them.
+fn entries_of(text: &str, source: &str) -> Result<(Vec<Entry>, Vec<Problem>), MachineError> {
+    let first = text
+        .trim_start_matches('\u{feff}')
+        .lines()
+        .map(str::trim)
+        .find(|l| !l.is_empty() && !l.starts_with('#'));
+    match first {
+        Some(l) if l.replace(' ', "").eq_ignore_ascii_case("key,value") => {
+            Ok(Machine::csv_entries(text))
+        }
+        _ => Machine::toml_entries(text, source),
     }
 }
 
@@ -660,6 +764,42 @@ fn finish(
 mod tests {
     use super::*;
     use crate::spec::DEFAULT_MACHINE_TOML;
+
+    #[test]
+    fn a_file_on_a_base_gives_only_what_it_changes() {
+        let m = Machine::from_toml_str(
+            "base = \"verne\"\nname = \"long\"\n[tool]\nlength = 120\n",
+            "long.toml",
+        )
+        .unwrap();
+        let d = Machine::default_verne();
+        assert_eq!((m.name.as_str(), m.tool_length), ("long", 120.0));
+        assert_eq!((m.module, m.limits, m.table), (d.module, d.limits, d.table));
+        let csv =
+            Machine::from_csv_str("key,value\nbase,verne\nlimits.rho1_max,900\n", "c.csv").unwrap();
+        assert_eq!(csv.limits.rho_max[0], 900.0);
+        // A key of the file keeps its line; an unknown base is the one problem.
+        let e = Machine::from_toml_str("base = \"verne\"\n[module]\nL1 = -1\n", "f").unwrap_err();
+        assert_eq!((e.problems.len(), e.problems[0].line), (1, Some(3)));
+        let e = Machine::from_toml_str("base = \"shop.toml\"\n", "f").unwrap_err();
+        assert_eq!(e.problems.len(), 1);
+        assert!(e.problems[0].message.contains("not known here"), "{e}");
+        // Chains resolve through the caller, and a cycle stops.
+        let resolve = |name: &str| -> Result<(String, String), String> {
+            match name {
+                "shop" => Ok((
+                    "base = \"verne\"\n[tool]\nlength = 80\n".into(),
+                    "shop".into(),
+                )),
+                "loop" => Ok(("base = \"loop\"\n".into(), "loop".into())),
+                _ => Err(format!("no {name}")),
+            }
+        };
+        let m = Machine::from_str_on_base("base = \"shop\"\n", "job", Some(&resolve)).unwrap();
+        assert_eq!(m.tool_length, 80.0);
+        let e = Machine::from_str_on_base("base = \"loop\"\n", "job", Some(&resolve)).unwrap_err();
+        assert!(e.to_string().contains("chain of bases"), "{e}");
+    }
 
     #[test]
     fn default_machine_matches_reference_geometry() {

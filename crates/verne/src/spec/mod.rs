@@ -4,7 +4,7 @@
 mod file;
 pub mod gcode;
 
-pub use file::MAX_LENGTH_MM;
+pub use file::{BaseResolver, MAX_BASE_DEPTH, MAX_LENGTH_MM};
 
 /// The embedded default machine (data/verne.toml).
 pub const DEFAULT_MACHINE_TOML: &str = include_str!("../../data/verne.toml");
