@@ -427,3 +427,40 @@ fn command_line_poses_are_counted_from_one_and_zero_has_no_sign() {
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("0.000") && !text.contains("-0.000"), "{text}");
 }
+
+#[test]
+fn prefer_is_honoured_where_a_vertical_start_decides_and_theta2_does_not_swing() {
+    // data/example.cl starts with a vertical FROM: the orientation is decided at the first
+    // tilted GOTO. Each preference must hold there, and the vertical rows before it take the
+    // theta2 that row needs (the rotary axis does not swing 90 degrees on the first move).
+    for (prefer, orientation, theta1_sign) in
+        [("orientation1", "1", -1.0), ("orientation2", "2", 1.0)]
+    {
+        let out = run(&["ik", "--prefer", prefer, "data/example.cl"], None);
+        assert_eq!(out.status.code(), Some(0));
+        let (h, rows) = table(&out);
+        let decided = rows
+            .iter()
+            .position(|r| !r[col(&h, "flags")].contains("near_rotary_singularity"))
+            .unwrap();
+        assert!(decided > 0, "the path starts vertical");
+        let d = &rows[decided];
+        assert_eq!(d[col(&h, "orientation")], orientation, "{prefer}");
+        let theta1: f64 = d[col(&h, "theta1")].parse().unwrap();
+        assert_eq!(theta1.signum(), theta1_sign, "{prefer}: theta1 {theta1}");
+        let t2 = |r: &Vec<String>| r[col(&h, "theta2")].parse::<f64>().unwrap();
+        for r in &rows[..decided] {
+            assert!(
+                (t2(r) - t2(d)).abs() < 1e-9,
+                "{prefer}: vertical row theta2 {} vs {}",
+                t2(r),
+                t2(d)
+            );
+        }
+    }
+    // The same file on stdin is read once: no look-ahead, theta2 starts at 0 (documented).
+    let example = std::fs::read_to_string(format!("{}/data/example.cl", common::ROOT)).unwrap();
+    let out = run(&["ik", "--prefer", "orientation2"], Some(&example));
+    let (h, rows) = table(&out);
+    assert_eq!(rows[0][col(&h, "theta2")], "0");
+}

@@ -96,7 +96,10 @@ fn offset_places_the_part_and_fk_takes_it_off() {
             v[5]
         ));
     }
-    let plain = run(&["ik"], Some(&moved));
+    // Given as a file, as the CL file was: both are read ahead to their first tilted pose.
+    let moved_file = std::env::temp_dir().join(format!("verne-offset-{}.csv", std::process::id()));
+    std::fs::write(&moved_file, &moved).unwrap();
+    let plain = run(&["ik", moved_file.to_str().unwrap()], None);
     assert_eq!(plain.status.code(), Some(0));
     let (h2, rows2) = table(&String::from_utf8(plain.stdout).unwrap());
     for (a, b) in rows.iter().zip(&rows2) {

@@ -4,8 +4,12 @@
 use crate::engine::machine_rows::{MachineIk, OrientationColumns};
 use crate::engine::module_rows::{ModuleIkAll, ModuleIkWorking};
 use crate::error::VerneError;
-use crate::table::CsvSource;
-use verne::machine::FirstRowChoice;
+use crate::table::{CsvSource, parse_number};
+use std::sync::{Arc, Mutex};
+
+use verne::machine::orientation::{ToolAngles, ToolOrientation};
+use verne::machine::{FirstRowChoice, PathState, first_decided_theta2};
+use verne::spec::Machine;
 
 use super::{Mechanism, inline_source, load_mechanism, refuse_for_glider, run_rows, units};
 use crate::cli::{IkArgs, OutputFormat, Prefer};
@@ -55,38 +59,12 @@ pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
         )));
     }
     let tool_length = args.tool_length.unwrap_or(machine.tool_length);
-    let mut cl_summary = None;
-    let mut gcode_summary = None;
+    let cl_summary;
+    let gcode_summary;
     let mut travel = None;
     crate::arg_values::spatial(&args.pose, "--pose", "XP,YP,ZP").map_err(VerneError::Usage)?;
-    let source = if !args.pose.is_empty() {
-        inline_source(
-            "xp,yp,zp",
-            &args.pose.iter().map(|p| p.to_vec()).collect::<Vec<_>>(),
-        )?
-    } else if !args.tool.is_empty() {
-        inline_source(
-            "x,y,z,i,j,k",
-            &args.tool.iter().map(|p| p.to_vec()).collect::<Vec<_>>(),
-        )?
-    } else {
-        let options = args.part.read_options(&machine.gcode);
-        match open_path_input(args.input.as_deref(), args.input_format, &options)? {
-            PathInput::Csv(src) => src,
-            PathInput::Gcode(reader, name) => {
-                let rows = TcpRows::new(*reader, &name, &machine.gcode);
-                gcode_summary = Some((rows.summary(), name.clone()));
-                CsvSource::from_reader(Box::new(TcpAsCsv::new(rows)), &name)?
-                    .with_line_column("line")
-            }
-            PathInput::Cl(reader, name) => {
-                let rows = ClRows::new(*reader);
-                cl_summary = Some((rows.summary(), name.clone()));
-                CsvSource::from_reader(Box::new(ClAsCsv::new(rows)), &name)?
-                    .with_line_column("line")
-            }
-        }
-    };
+    let (source, summaries) = open_source(args, &machine)?;
+    (cl_summary, gcode_summary) = summaries;
     let source = match args.period {
         Some(period) => {
             if source.column("xp").is_some() && source.column("x").is_none() {
@@ -122,8 +100,18 @@ pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
                 Prefer::Orientation2 => FirstRowChoice::Orientation2,
             };
             let machine_for_travel = machine.clone();
+            // A path that starts with the tool vertical: its orientation is decided further on;
+            // look there first, so that --prefer is honoured and theta2 does not swing.
+            let seed = if args.all {
+                None
+            } else {
+                prescan_theta2(args, &machine, tool_length, offset, first)?
+            };
             let mut job = MachineIk::new(machine, tool_length, orientation, args.all, first);
             job.offset = offset;
+            if let Some(theta2) = seed {
+                job.state = PathState::with_theta2(first, theta2);
+            }
             let code = run_rows("ik", &mut job, source, args.output.as_ref(), u)?;
             // A CAM job (a CL file or a program): where the joints went, against the limits.
             if (cl_summary.is_some() || gcode_summary.is_some()) && job.travel.rows > 0 {
@@ -169,4 +157,93 @@ pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
         );
     }
     Ok(code)
+}
+
+type Summaries = (
+    Option<(Arc<Mutex<verne_cl::Summary>>, String)>,
+    Option<(Arc<Mutex<verne_gcode::Summary>>, String)>,
+);
+
+/// The rows of `verne ik` as CSV: inline poses, a CSV, a CL file or a G-code program (with the
+/// reader's summary, shared, to print at the end).
+fn open_source(args: &IkArgs, machine: &Machine) -> Result<(CsvSource, Summaries), VerneError> {
+    if !args.pose.is_empty() {
+        let rows: Vec<Vec<f64>> = args.pose.iter().map(|p| p.to_vec()).collect();
+        return Ok((inline_source("xp,yp,zp", &rows)?, (None, None)));
+    }
+    if !args.tool.is_empty() {
+        let rows: Vec<Vec<f64>> = args.tool.iter().map(|p| p.to_vec()).collect();
+        return Ok((inline_source("x,y,z,i,j,k", &rows)?, (None, None)));
+    }
+    let options = args.part.read_options(&machine.gcode);
+    Ok(
+        match open_path_input(args.input.as_deref(), args.input_format, &options)? {
+            PathInput::Csv(src) => (src, (None, None)),
+            PathInput::Gcode(reader, name) => {
+                let rows = TcpRows::new(*reader, &name, &machine.gcode);
+                let summary = Some((rows.summary(), name.clone()));
+                let src = CsvSource::from_reader(Box::new(TcpAsCsv::new(rows)), &name)?;
+                (src.with_line_column("line"), (None, summary))
+            }
+            PathInput::Cl(reader, name) => {
+                let rows = ClRows::new(*reader);
+                let summary = Some((rows.summary(), name.clone()));
+                let src = CsvSource::from_reader(Box::new(ClAsCsv::new(rows)), &name)?;
+                (src.with_line_column("line"), (summary, None))
+            }
+        },
+    )
+}
+
+/// Rows read ahead at most, looking for the first pose outside the rotary-singularity cone.
+const PRESCAN_ROWS: usize = 100_000;
+
+/// The theta2 that the path's first decided pose needs ([`first_decided_theta2`]), read ahead
+/// in a second pass over the input: a file or the command line's poses (stdin is read once,
+/// so a path on stdin starts at theta2 = 0). Rows that cannot be read end the look-ahead (the
+/// main pass reports them).
+fn prescan_theta2(
+    args: &IkArgs,
+    machine: &Machine,
+    tool_length: f64,
+    offset: nalgebra::Vector3<f64>,
+    first: FirstRowChoice,
+) -> Result<Option<f64>, VerneError> {
+    let rereadable =
+        !args.tool.is_empty() || args.input.as_ref().is_some_and(|p| p.as_os_str() != "-");
+    if !rereadable {
+        return Ok(None);
+    }
+    let (mut src, _) = open_source(args, machine)?;
+    let col = |c: &str| src.column(c);
+    let (Some(x), Some(y), Some(z)) = (col("x"), col("y"), col("z")) else {
+        return Ok(None);
+    };
+    let axis = [col("i"), col("j"), col("k")];
+    let angles = [col("phi1"), col("phi2")];
+    let radians = args.common.radians;
+    let mut rec = csv::ByteRecord::new();
+    let poses = std::iter::from_fn(|| {
+        if !src.read(&mut rec).ok()? {
+            return None;
+        }
+        let num = |i: usize| parse_number(rec.get(i).unwrap_or(b"")).ok();
+        let tip = nalgebra::Vector3::new(num(x)?, num(y)?, num(z)?) + offset;
+        let orientation = match (axis, angles) {
+            ([Some(i), Some(j), Some(k)], _) => {
+                ToolOrientation::Axis(nalgebra::Vector3::new(num(i)?, num(j)?, num(k)?))
+            }
+            (_, [Some(p1), Some(p2)]) => {
+                let a = |v: f64| if radians { v } else { v.to_radians() };
+                ToolOrientation::Angles(ToolAngles {
+                    phi1: a(num(p1)?),
+                    phi2: a(num(p2)?),
+                })
+            }
+            _ => return None,
+        };
+        Some((tip, orientation))
+    })
+    .take(PRESCAN_ROWS);
+    Ok(first_decided_theta2(machine, poses, tool_length, first))
 }

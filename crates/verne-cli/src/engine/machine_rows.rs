@@ -254,14 +254,15 @@ impl RowJob for MachineIk {
         };
         let candidates = outcome.as_ref().map(|()| &solved.candidates);
         let recomputed;
-        let candidates = match (candidates, solved.orientation, self.state.previous()) {
-            (Ok(c), Some(o), Some(prev)) if c.needs_previous() && !self.all => {
+        let reference = self.state.reference_theta2();
+        let candidates = match (candidates, solved.orientation, reference) {
+            (Ok(c), Some(o), Some(theta2)) if c.needs_previous() && !self.all => {
                 recomputed = path_candidates(
                     &self.machine,
                     &solved.tip,
                     &o,
                     self.tool_length,
-                    Some(prev.theta2),
+                    Some(theta2),
                 );
                 recomputed.as_ref()
             }

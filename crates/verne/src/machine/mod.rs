@@ -32,7 +32,7 @@ pub use ik::{
 };
 pub use path::{
     FirstRowChoice, JOINT_DISTANCE_MM_PER_RAD, PathCandidates, PathError, PathRow, PathState,
-    path_candidates, path_candidates_into,
+    first_decided_theta2, path_candidates, path_candidates_into,
 };
 pub use transforms::{
     platform_transform, table_transform, tool_pose_eq26, tool_tip_by_transforms, tool_transform,

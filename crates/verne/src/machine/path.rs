@@ -116,6 +116,9 @@ impl std::error::Error for PathError {}
 pub struct PathState {
     first: FirstRowChoice,
     prev: Option<PathRow>,
+    /// theta2 for the rows before the first one chosen: the value that the path's first row
+    /// outside the rotary-singularity cone needs ([`first_decided_theta2`]).
+    seed_theta2: Option<f64>,
 }
 
 /// A candidate branch with the orientation it came from and its theta2.
@@ -246,12 +249,33 @@ pub fn path_candidates_into(
 impl PathState {
     /// A new path; `first` says how to choose on the first row.
     pub fn new(first: FirstRowChoice) -> PathState {
-        PathState { first, prev: None }
+        PathState {
+            first,
+            prev: None,
+            seed_theta2: None,
+        }
+    }
+
+    /// A new path whose rows inside the rotary-singularity cone, before any other, take
+    /// `theta2` (rad): the value the first row outside the cone needs, so that the first
+    /// tilted move does not swing the rotary axis, and `first` is honoured where the
+    /// orientation is decided.
+    pub fn with_theta2(first: FirstRowChoice, theta2: f64) -> PathState {
+        PathState {
+            first,
+            prev: None,
+            seed_theta2: Some(theta2),
+        }
     }
 
     /// The last row chosen, if any.
     pub fn previous(&self) -> Option<&PathRow> {
         self.prev.as_ref()
+    }
+
+    /// The theta2 the next row is unwrapped near: the previous row's, else the seed.
+    pub fn reference_theta2(&self) -> Option<f64> {
+        self.prev.map(|p| p.theta2).or(self.seed_theta2)
     }
 
     /// Chooses the branch for the next row. On error the state is unchanged, so the next row
@@ -263,7 +287,7 @@ impl PathState {
         orientation: &ToolOrientation,
         tool_length: f64,
     ) -> Result<PathRow, PathError> {
-        let prev_theta2 = self.prev.map(|p| p.theta2);
+        let prev_theta2 = self.reference_theta2();
         let candidates = path_candidates(m, tip, orientation, tool_length, prev_theta2)?;
         self.choose(&candidates)
     }
@@ -280,7 +304,10 @@ impl PathState {
             .iter()
             .map(|&(angles, label)| {
                 let t = wrap_angle(-angles.phi2);
-                (label, self.prev.map_or(t, |p| unwrap_near(t, p.theta2)))
+                (
+                    label,
+                    self.reference_theta2().map_or(t, |r| unwrap_near(t, r)),
+                )
             })
             .collect();
         let theta2 = |c: &Candidate| {
@@ -373,4 +400,38 @@ impl PathState {
         self.prev = Some(row);
         Ok(row)
     }
+}
+
+/// The theta2 (rad) that the first pose outside the rotary-singularity cone needs, when the
+/// path starts inside the cone (a vertical tool, as almost every CL file's FROM); `None` when
+/// the first pose is already outside it, or no pose of `poses` is (or has a working branch).
+/// With a preferred orientation (`first`), the branch that preference takes there; with
+/// [`FirstRowChoice::SmallestTheta1`], the branch that the path followed from theta2 = 0 reaches
+/// there (the choice is the one made without look-ahead; only the swing of the rotary axis on
+/// the first tilted move goes). A path started with [`PathState::with_theta2`] of it keeps
+/// theta2 still until the orientation is decided.
+pub fn first_decided_theta2(
+    m: &Machine,
+    poses: impl IntoIterator<Item = (Vector3<f64>, ToolOrientation)>,
+    tool_length: f64,
+    first: FirstRowChoice,
+) -> Option<f64> {
+    let mut followed = PathState::new(first);
+    for (k, (tip, orientation)) in poses.into_iter().enumerate() {
+        let theta2 = followed.reference_theta2();
+        let c = path_candidates(m, &tip, &orientation, tool_length, theta2).ok()?;
+        if c.needs_previous() {
+            followed.choose(&c).ok()?;
+            continue;
+        }
+        if k == 0 {
+            return None;
+        }
+        let row = match first {
+            FirstRowChoice::SmallestTheta1 => followed.choose(&c),
+            _ => PathState::new(first).choose(&c),
+        };
+        return row.ok().map(|r| r.theta2);
+    }
+    None
 }
