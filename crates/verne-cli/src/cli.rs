@@ -343,7 +343,7 @@ pub struct WorkspaceArgs {
     pub tool_length: Vec<f64>,
     /// Grid step (mm), the same along x, y and z [default: 10 mm; for a glider, 801 nodes along
     /// the longer side].
-    #[arg(long, value_name = "MM")]
+    #[arg(long, value_name = "MM", allow_negative_numbers = true)]
     pub step: Option<f64>,
     /// Box sampled (mm, in the workspace's frame). Default: derived from the machine's rod
     /// lengths, rod-tilt limit and strokes (docs/workspace.md).

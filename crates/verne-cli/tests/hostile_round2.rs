@@ -351,3 +351,43 @@ fn headers_match_ignoring_case() {
     let missing = run(&["ik"], Some("a,b\n1,2\n"));
     assert!(stderr(&missing).contains("tool poses x,y,z with i,j,k or phi1,phi2"));
 }
+
+#[test]
+fn round2_item9_negative_step_comment_after_section_and_semicolon_machine_files() {
+    let stderr = |o: &std::process::Output| String::from_utf8_lossy(&o.stderr).into_owned();
+    // --step -10: the value is read, then refused for its sign (not "unexpected argument -1").
+    let s = common::run(&["workspace", "--step", "-10"], None);
+    assert_eq!(s.status.code(), Some(2));
+    assert!(stderr(&s).contains("positive"), "{}", stderr(&s));
+    let dir = std::env::temp_dir().join(format!("verne-item9-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // `[module] # comment` keeps the lines of the keys in that section.
+    let base = std::fs::read_to_string(format!("{}/data/verne.toml", common::ROOT)).unwrap();
+    let text = base
+        .replace("[module]\n", "[module] # the parallel module\n")
+        .replace("L1 = 850.0", "L1 = -850.0");
+    let line = text
+        .lines()
+        .position(|l| l.starts_with("L1 = -850.0"))
+        .unwrap()
+        + 1;
+    let f = dir.join("comment.toml");
+    std::fs::write(&f, text).unwrap();
+    let c = common::run(&["machine", "check", f.to_str().unwrap()], None);
+    assert_eq!(c.status.code(), Some(2));
+    assert!(
+        stderr(&c).contains(&format!("comment.toml:{line}: module.L1")),
+        "{}",
+        stderr(&c)
+    );
+    // A key;value file is named for what it is, not "not valid TOML".
+    let f = dir.join("semi.csv");
+    std::fs::write(&f, "key;value\nmodule.R1;130\n").unwrap();
+    let c = common::run(&["machine", "check", f.to_str().unwrap()], None);
+    assert_eq!(c.status.code(), Some(2));
+    assert!(
+        stderr(&c).contains("comma-separated") && !stderr(&c).contains("TOML"),
+        "{}",
+        stderr(&c)
+    );
+}

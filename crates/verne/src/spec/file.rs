@@ -511,6 +511,17 @@ fn entries_of(text: &str, source: &str) -> Result<(Vec<Entry>, Vec<Problem>), Ma
         Some(l) if l.replace(' ', "").eq_ignore_ascii_case("key,value") => {
             Ok(Machine::csv_entries(text))
         }
+        Some(l) if l.replace(' ', "").eq_ignore_ascii_case("key;value") => Err(MachineError {
+            source: source.to_string(),
+            problems: vec![Problem {
+                line: text
+                    .lines()
+                    .position(|x| x.trim() == l)
+                    .map(|i| i + 1),
+                key: String::new(),
+                message: "a key;value table: machine CSV files are comma-separated (`key,value`, then `module.R1,130`)".into(),
+            }],
+        }),
         _ => Machine::toml_entries(text, source),
     }
 }
@@ -543,7 +554,8 @@ impl TomlLines {
         for (i, line) in text.lines().enumerate() {
             let t = line.trim();
             if let Some(rest) = t.strip_prefix('[') {
-                current = rest.trim_end_matches(']').trim().to_string();
+                // `[module] # a comment`: the name ends at the first `]`.
+                current = rest.split(']').next().unwrap_or("").trim().to_string();
                 continue;
             }
             if t.contains('=') {
