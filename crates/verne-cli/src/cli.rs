@@ -366,6 +366,14 @@ pub struct WorkspaceArgs {
     /// three horizontal slices across the workspace.
     #[arg(long, value_name = "z=VALUE", value_parser = parse_slice, requires = "plot", allow_hyphen_values = true)]
     pub slice: Vec<(usize, f64)>,
+    /// Adaptive sampling: a coarse grid (8 steps), refined only where the workspace's boundary
+    /// passes; the cost grows with the boundary, not the volume. The default below a 5 mm step
+    /// when no points CSV or picture is asked (they need every grid point).
+    #[arg(long, conflicts_with = "uniform")]
+    pub adaptive: bool,
+    /// Every grid point classified (the default at 5 mm and above, and with -o or --plot).
+    #[arg(long)]
+    pub uniform: bool,
     #[command(flatten)]
     pub common: CommonArgs,
 }

@@ -4,6 +4,9 @@
 
 use std::process::Command;
 
+mod common;
+use common::run;
+
 use nalgebra::Vector3;
 use verne::parallel_module::equations::ModulePose;
 use verne::parallel_module::ik;
@@ -133,4 +136,40 @@ fn the_command_writes_the_points_its_summary_counts() {
     assert_eq!(bad.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("--tool-length"));
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn adaptive_sampling_gives_the_uniform_volume() {
+    let out = |args: &[&str]| {
+        let o = run(args, None);
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        String::from_utf8_lossy(&o.stdout).into_owned()
+    };
+    let adaptive = out(&["workspace", "--step", "20", "--adaptive"]);
+    let uniform = out(&["workspace", "--step", "20", "--uniform"]);
+    let volume = |text: &str, key: &str| -> f64 {
+        let line = text
+            .lines()
+            .find(|l| l.trim_start().starts_with(key))
+            .unwrap_or_else(|| panic!("{text}"));
+        line.split_whitespace().nth(1).unwrap().parse().unwrap()
+    };
+    let a = volume(&adaptive, "volume");
+    let u = volume(&uniform, "volume");
+    assert!(
+        (a - u).abs() < 1e-3,
+        "adaptive {a} l, uniform {u} l\n{adaptive}\n{uniform}"
+    );
+    assert!(adaptive.contains("bracket") && adaptive.contains("points classified"));
+    // Points and pictures need every grid point.
+    let refused = run(
+        &["workspace", "--step", "20", "--adaptive", "-o", "-"],
+        None,
+    );
+    assert_eq!(refused.status.code(), Some(2));
 }

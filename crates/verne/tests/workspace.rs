@@ -256,3 +256,83 @@ fn a_zero_length_tool_has_the_platform_workspace() {
     assert_eq!(p.map.outcome, t.map.outcome);
     assert_eq!(p.summary.volume_mm3, t.summary.volume_mm3);
 }
+
+// ---------------------------------------------------------------------------------------------
+// Adaptive sampling (workspace/adaptive.rs) against the uniform grid at the same step: the
+// same inside points (the estimator the volume is made of), the volume inside the adaptive
+// run's own bracket, and far fewer points classified at a fine step.
+
+fn compare(m: &Machine, opts: &WorkspaceOptions, factor: usize) -> (u64, u64) {
+    let uniform = workspace::compute(m, opts, &|_| {}, |_| Ok::<(), ()>(()))
+        .unwrap()
+        .unwrap()
+        .summary;
+    let adaptive = workspace::compute_adaptive(m, opts, factor, &|_| {}).unwrap();
+    let name = format!(
+        "{} {} mm, tool {} mm",
+        opts.of.name(),
+        opts.step,
+        opts.tool_length
+    );
+    assert!(uniform.inside > 100, "{name}: a workspace to compare");
+    assert!(
+        !uniform.touches_bounds,
+        "{name}: the bounds hold the workspace"
+    );
+    assert_eq!(
+        adaptive.inside_points, uniform.inside,
+        "{name}: inside points"
+    );
+    assert!((adaptive.volume_mm3 - uniform.volume_mm3).abs() < 1e-6 * uniform.volume_mm3);
+    assert!(
+        adaptive.volume_lo_mm3 <= adaptive.volume_mm3
+            && adaptive.volume_mm3 <= adaptive.volume_hi_mm3,
+        "{name}: {} not in [{}, {}]",
+        adaptive.volume_mm3,
+        adaptive.volume_lo_mm3,
+        adaptive.volume_hi_mm3
+    );
+    assert_eq!(adaptive.binding[0], uniform.inside);
+    let (ub, ab) = (uniform.bbox.unwrap(), adaptive.bbox.unwrap());
+    assert!(
+        (ub.min - ab.min).norm() < 1e-9 && (ub.max - ab.max).norm() < 1e-9,
+        "{name}: bbox"
+    );
+    (adaptive.classified, uniform.points)
+}
+
+#[test]
+fn adaptive_equals_uniform_on_the_default_machine() {
+    let m = Machine::default_verne();
+    compare(&m, &options(Of::Platform, 0.0, 20.0), 8);
+    compare(&m, &options(Of::Tool, 100.0, 25.0), 4);
+    // At 10 mm the boundary is already a small part of the volume.
+    let (classified, points) = compare(&m, &options(Of::Platform, 0.0, 10.0), 8);
+    assert!(
+        classified * 4 < points,
+        "{classified} classified for {points} grid points"
+    );
+}
+
+#[test]
+fn adaptive_equals_uniform_on_other_machines() {
+    // A shorter leg I and narrower strokes: a different shape.
+    let text = verne::spec::DEFAULT_MACHINE_TOML
+        .replace("L1 = 850.0", "L1 = 700.0")
+        .replace("rho2_max = 1100.0", "rho2_max = 800.0");
+    let m = Machine::from_toml_str(&text, "other").unwrap();
+    compare(&m, &options(Of::Platform, 0.0, 25.0), 8);
+}
+
+#[test]
+fn bad_options_are_refused() {
+    let m = Machine::default_verne();
+    let o = options(Of::Platform, 0.0, 10.0);
+    assert!(workspace::compute_adaptive(&m, &o, 3, &|_| {}).is_err());
+    assert!(
+        workspace::compute_adaptive(&m, &options(Of::Platform, 0.0, -1.0), 8, &|_| {}).is_err()
+    );
+    assert!(
+        workspace::compute_adaptive(&m, &options(Of::Platform, 0.0, 1e-9), 8, &|_| {}).is_err()
+    );
+}

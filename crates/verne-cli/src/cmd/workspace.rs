@@ -22,6 +22,89 @@ use crate::cli::{WorkspaceArgs, WorkspaceOf};
 /// Grid step of the VERNE workspace when `--step` is not given (mm).
 const DEFAULT_STEP_MM: f64 = 10.0;
 
+/// Below this step (mm), `verne workspace` samples adaptively unless told otherwise.
+const ADAPTIVE_BELOW_MM: f64 = 5.0;
+
+/// `verne workspace --adaptive`: one adaptive run per tool length, its summary on stdout.
+fn run_adaptive(
+    machine: &verne::spec::Machine,
+    of: Of,
+    lengths: &[f64],
+    step: f64,
+    bounds: Option<Bounds>,
+    lambda: [f64; 2],
+) -> Result<u8, VerneError> {
+    let mut text = String::new();
+    let mut any_empty = false;
+    for &l in lengths {
+        let opts = options(of, l, step, bounds, lambda);
+        let start = Instant::now();
+        let a =
+            workspace::compute_adaptive(machine, &opts, workspace::DEFAULT_COARSE_FACTOR, &|_| {})
+                .map_err(VerneError::Usage)?;
+        let secs = start.elapsed().as_secs_f64();
+        let tool = if of == Of::Platform {
+            String::new()
+        } else {
+            format!(", tool length {l} mm")
+        };
+        let _ = writeln!(
+            text,
+            "{} workspace{tool} of `{}` ({}), adaptive: step {step} mm, coarse step {} mm",
+            of.name(),
+            machine.name,
+            of.frame(),
+            a.coarse_step
+        );
+        let _ = writeln!(
+            text,
+            "  volume             {:.4} l (inside points x step^3, as the uniform grid counts them)",
+            a.volume_mm3 * 1e-6
+        );
+        let _ = writeln!(
+            text,
+            "  bracket            [{:.4}, {:.4}] l: cells all inside, plus the {} boundary cells of one step (width {:.3} %)",
+            a.volume_lo_mm3 * 1e-6,
+            a.volume_hi_mm3 * 1e-6,
+            a.boundary_cells,
+            if a.volume_mm3 > 0.0 {
+                100.0 * a.error_bound_mm3() / a.volume_mm3
+            } else {
+                0.0
+            }
+        );
+        let _ = writeln!(
+            text,
+            "  points classified  {} of {} lattice points ({:.2} %), {secs:.1} s",
+            a.classified,
+            a.lattice_points,
+            100.0 * a.classified as f64 / a.lattice_points as f64
+        );
+        if let Some(b) = a.bbox {
+            let _ = writeln!(
+                text,
+                "  bounding box       x [{}, {}]  y [{}, {}]  z [{}, {}] mm{}",
+                b.min.x,
+                b.max.x,
+                b.min.y,
+                b.max.y,
+                b.min.z,
+                b.max.z,
+                if a.touches_bounds {
+                    " (touches the sampled box: widen --bounds)"
+                } else {
+                    ""
+                }
+            );
+        } else {
+            any_empty = true;
+            let _ = writeln!(text, "  no point inside");
+        }
+    }
+    write_stdout(&text)?;
+    Ok(if any_empty { EXIT_ROWS_FAILED } else { EXIT_OK })
+}
+
 pub fn run(args: &WorkspaceArgs) -> Result<u8, VerneError> {
     if let Some(spec) = super::glider::load(args.common.machine.as_deref())? {
         return super::glider::workspace(
@@ -73,6 +156,19 @@ pub fn run(args: &WorkspaceArgs) -> Result<u8, VerneError> {
         workspace::grid_for(&machine, &opts).map_err(VerneError::Usage)?;
     }
 
+    let adaptive = match (args.adaptive, args.uniform) {
+        (true, _) => true,
+        (_, true) => false,
+        _ => step < ADAPTIVE_BELOW_MM && args.output.is_none() && args.plot.is_none(),
+    };
+    if adaptive {
+        if args.output.is_some() || args.plot.is_some() {
+            return Err(VerneError::Usage(
+                "--adaptive classifies only the points near the boundary: the points CSV (-o) and the pictures (--plot) need every grid point (--uniform)".into(),
+            ));
+        }
+        return run_adaptive(&machine, of, &lengths, step, bounds, lambda);
+    }
     let to_stdout = args.output.as_deref().is_some_and(|p| p.as_os_str() == "-");
     let mut sink = match &args.output {
         Some(p) => Some(Sink::create(Some(p.as_path()))?),

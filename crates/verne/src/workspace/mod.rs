@@ -30,6 +30,7 @@
 //! inside, [`largest_box()`]); here, the types of a result and the run over the grid
 //! ([`compute`]).
 
+mod adaptive;
 mod classify;
 mod grid;
 mod largest_box;
@@ -40,6 +41,7 @@ use crate::par::*;
 use crate::parallel_module::equations::{ModulePose, Sliders};
 use crate::spec::Machine;
 
+pub use adaptive::{AdaptiveSummary, DEFAULT_COARSE_FACTOR, compute_adaptive};
 pub use classify::{ALPHA_MATCH_RAD, classify, grid_point_of, manufacturing_tip, tool_tip};
 pub use grid::{Bounds, Grid, GridBox, MAX_GRID_POINTS, default_bounds, grid_for, round_bounds};
 pub use largest_box::largest_box;
