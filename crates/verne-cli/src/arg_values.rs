@@ -22,6 +22,34 @@ pub fn parse_triple(s: &str) -> Result<[f64; 3], String> {
     Ok(out)
 }
 
+/// Parses a design sweep `KEY=FROM..TO:N` (N >= 1 values, from FROM to TO inclusive; N = 1
+/// gives FROM alone).
+pub fn parse_sweep(s: &str) -> Result<(String, f64, f64, usize), String> {
+    let usage = "expected KEY=FROM..TO:N, e.g. module.L1=800..900:11";
+    let (key, range) = s.split_once('=').ok_or(usage)?;
+    let (span, n) = range.rsplit_once(':').ok_or(usage)?;
+    let (from, to) = span.split_once("..").ok_or(usage)?;
+    let num = |t: &str| -> Result<f64, String> {
+        match t.trim().parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok(v),
+            _ => Err(format!("`{t}` is not a number; {usage}")),
+        }
+    };
+    let n: usize = n
+        .trim()
+        .parse()
+        .ok()
+        .filter(|n| (1..=1000).contains(n))
+        .ok_or_else(|| format!("`{n}`: N must be a whole number from 1 to 1000; {usage}"))?;
+    let key = key.trim();
+    if key.is_empty() || !key.contains('.') {
+        return Err(format!(
+            "`{key}`: the key of a machine file, section.key; {usage}"
+        ));
+    }
+    Ok((key.to_string(), num(from)?, num(to)?, n))
+}
+
 /// Parses a point of either mechanism: `X,Y,Z` (the VERNE machine) or `X,Y` (a planar glider;
 /// the third value is then NaN, which the VERNE commands refuse with [`spatial`]).
 pub fn parse_point(s: &str) -> Result<[f64; 3], String> {

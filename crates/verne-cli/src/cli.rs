@@ -374,6 +374,11 @@ pub struct WorkspaceArgs {
     /// Every grid point classified (the default at 5 mm and above, and with -o or --plot).
     #[arg(long)]
     pub uniform: bool,
+    /// A design sweep: one adaptive workspace per value of a machine-file key, KEY=FROM..TO:N
+    /// (e.g. module.L1=800..900:11, tool.length=0..150:7); twice for a grid of two keys. Writes
+    /// a CSV table (-o, or stdout): the key values, volume, bracket, bounding box, cost.
+    #[arg(long, value_name = "KEY=FROM..TO:N", value_parser = crate::arg_values::parse_sweep)]
+    pub sweep: Vec<(String, f64, f64, usize)>,
     #[command(flatten)]
     pub common: CommonArgs,
 }

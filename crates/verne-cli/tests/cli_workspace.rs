@@ -173,3 +173,74 @@ fn adaptive_sampling_gives_the_uniform_volume() {
     );
     assert_eq!(refused.status.code(), Some(2));
 }
+
+#[test]
+fn a_sweep_row_is_the_workspace_of_that_machine() {
+    let o = run(
+        &[
+            "workspace",
+            "--step",
+            "40",
+            "--sweep",
+            "module.L1=800..850:2",
+        ],
+        None,
+    );
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let text = String::from_utf8_lossy(&o.stdout).into_owned();
+    let rows: Vec<Vec<&str>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    assert_eq!(rows.len(), 2);
+    assert_eq!((rows[0][0], rows[1][0]), ("800", "850"));
+    // L1 = 850 is the default machine: its row is `workspace --adaptive` of it.
+    let one = run(&["workspace", "--step", "40", "--adaptive"], None);
+    let summary = String::from_utf8_lossy(&one.stdout).into_owned();
+    let volume = summary
+        .lines()
+        .find(|l| l.trim_start().starts_with("volume"))
+        .and_then(|l| l.split_whitespace().nth(1))
+        .unwrap();
+    assert_eq!(rows[1][1], volume, "{summary}");
+    // L1 = 800 as a machine file over the default gives the same as its row.
+    let dir = std::env::temp_dir().join(format!("verne-sweep-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let f = dir.join("l800.toml");
+    std::fs::write(&f, "base = \"verne\"\n[module]\nL1 = 800\n").unwrap();
+    let m = run(
+        &[
+            "workspace",
+            "-m",
+            f.to_str().unwrap(),
+            "--step",
+            "40",
+            "--adaptive",
+        ],
+        None,
+    );
+    let s = String::from_utf8_lossy(&m.stdout).into_owned();
+    assert!(
+        s.contains(&format!("volume             {} l", rows[0][1])),
+        "{s}\n{text}"
+    );
+    // A value that makes an invalid machine stops the sweep before it runs.
+    let bad = run(
+        &[
+            "workspace",
+            "--step",
+            "40",
+            "--sweep",
+            "module.L1=-5..900:2",
+        ],
+        None,
+    );
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("module.L1"));
+}

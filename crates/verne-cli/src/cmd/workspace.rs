@@ -25,6 +25,127 @@ const DEFAULT_STEP_MM: f64 = 10.0;
 /// Below this step (mm), `verne workspace` samples adaptively unless told otherwise.
 const ADAPTIVE_BELOW_MM: f64 = 5.0;
 
+/// `verne workspace --sweep KEY=FROM..TO:N [--sweep KEY2=...]`: one adaptive workspace per
+/// value (per pair of values), each machine read as a file over the given one (so every value
+/// is validated as a machine file is), the table as CSV on -o or stdout.
+fn run_sweep(
+    args: &WorkspaceArgs,
+    machine: &verne::spec::Machine,
+    of: Of,
+    step: f64,
+    bounds: Option<Bounds>,
+    lambda: [f64; 2],
+) -> Result<u8, VerneError> {
+    let values = |(_, from, to, n): &(String, f64, f64, usize)| -> Vec<f64> {
+        (0..*n)
+            .map(|k| {
+                if *n == 1 {
+                    *from
+                } else {
+                    from + (to - from) * k as f64 / (*n - 1) as f64
+                }
+            })
+            .collect()
+    };
+    let keys: Vec<&str> = args.sweep.iter().map(|s| s.0.as_str()).collect();
+    let mut points: Vec<Vec<f64>> = values(&args.sweep[0])
+        .into_iter()
+        .map(|v| vec![v])
+        .collect();
+    if let Some(second) = args.sweep.get(1) {
+        points = points
+            .into_iter()
+            .flat_map(|p| {
+                values(second)
+                    .into_iter()
+                    .map(move |v| [p.clone(), vec![v]].concat())
+            })
+            .collect();
+    }
+    let base = machine.to_toml();
+    let resolve = |_: &str| -> Result<(String, String), String> {
+        Ok((base.clone(), "the machine swept".to_string()))
+    };
+    // Every machine first: a value that makes an invalid machine stops the sweep before it runs.
+    let mut machines = Vec::with_capacity(points.len());
+    for p in &points {
+        let mut text = String::from("base = \"swept\"\n");
+        for (key, v) in keys.iter().zip(p) {
+            let (section, name) = key.split_once('.').unwrap_or(("", key));
+            text.push_str(&format!("[{section}]\n{name} = {v:?}\n"));
+        }
+        let label = keys
+            .iter()
+            .zip(p)
+            .map(|(k, v)| format!("{k}={v}"))
+            .collect::<Vec<_>>()
+            .join(", ");
+        let m = verne::spec::Machine::from_str_on_base(
+            &text,
+            &format!("--sweep {label}"),
+            Some(&resolve),
+        )?;
+        machines.push(m);
+    }
+    let mut sink = Sink::create(args.output.as_deref())?;
+    let mut header: Vec<String> = keys.iter().map(|k| k.to_string()).collect();
+    header.extend(
+        [
+            "volume_l",
+            "bracket_lo_l",
+            "bracket_hi_l",
+            "xmin",
+            "xmax",
+            "ymin",
+            "ymax",
+            "zmin",
+            "zmax",
+            "points_classified",
+            "seconds",
+        ]
+        .map(String::from),
+    );
+    sink.write(&ByteRecord::from(header))?;
+    let mut any_empty = false;
+    for (p, m) in points.iter().zip(&machines) {
+        let opts = options(of, m.tool_length, step, bounds, lambda);
+        let start = Instant::now();
+        let a = workspace::compute_adaptive(m, &opts, workspace::DEFAULT_COARSE_FACTOR, &|_| {})
+            .map_err(VerneError::Usage)?;
+        let secs = start.elapsed().as_secs_f64();
+        let mut row: Vec<String> = p.iter().map(|v| v.to_string()).collect();
+        row.push(format!("{:.4}", a.volume_mm3 * 1e-6));
+        row.push(format!("{:.4}", a.volume_lo_mm3 * 1e-6));
+        row.push(format!("{:.4}", a.volume_hi_mm3 * 1e-6));
+        match a.bbox {
+            Some(b) => {
+                for d in 0..3 {
+                    row.push(b.min[d].to_string());
+                    row.push(b.max[d].to_string());
+                }
+            }
+            None => {
+                any_empty = true;
+                row.extend(std::iter::repeat_n(String::new(), 6));
+            }
+        }
+        row.push(a.classified.to_string());
+        row.push(format!("{secs:.2}"));
+        sink.write(&ByteRecord::from(row))?;
+        sayln!(
+            "verne workspace: {}: {:.3} l in {secs:.1} s",
+            keys.iter()
+                .zip(p)
+                .map(|(k, v)| format!("{k}={v}"))
+                .collect::<Vec<_>>()
+                .join(", "),
+            a.volume_mm3 * 1e-6
+        );
+    }
+    sink.finish()?;
+    Ok(if any_empty { EXIT_ROWS_FAILED } else { EXIT_OK })
+}
+
 /// `verne workspace --adaptive`: one adaptive run per tool length, its summary on stdout.
 fn run_adaptive(
     machine: &verne::spec::Machine,
@@ -156,6 +277,19 @@ pub fn run(args: &WorkspaceArgs) -> Result<u8, VerneError> {
         workspace::grid_for(&machine, &opts).map_err(VerneError::Usage)?;
     }
 
+    if !args.sweep.is_empty() {
+        if args.uniform
+            || args.plot.is_some()
+            || !args.tool_length.is_empty()
+            || args.sweep.len() > 2
+            || of == Of::Platform && args.sweep.iter().any(|s| s.0 == "tool.length")
+        {
+            return Err(VerneError::Usage(
+                "--sweep runs adaptive workspaces over one or two machine-file keys (tool.length with --of tool or manufacturing): no --uniform, --plot or --tool-length".into(),
+            ));
+        }
+        return run_sweep(args, &machine, of, step, bounds, lambda);
+    }
     let adaptive = match (args.adaptive, args.uniform) {
         (true, _) => true,
         (_, true) => false,
