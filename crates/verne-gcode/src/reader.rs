@@ -10,7 +10,7 @@ use super::arc::{self, ArcWords};
 use super::block::{Block, Word};
 use super::cycle::{self, CycleWords};
 use super::error::GcodeError;
-use super::types::{Axis, Kind, Motion, Options, Row, Summary, Units};
+use super::types::{AXES, Axis, Kind, Motion, Options, Row, Summary, Units};
 
 /// The motion mode (modal group 1).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -517,17 +517,7 @@ impl<R: BufRead> Reader<R> {
                 self.state.cycle_continuing = false;
             }
         }
-        for a in [
-            Axis::X,
-            Axis::Y,
-            Axis::Z,
-            Axis::A,
-            Axis::B,
-            Axis::C,
-            Axis::U,
-            Axis::V,
-            Axis::W,
-        ] {
+        for a in AXES {
             if axes[a as usize].is_some() {
                 self.summary.axes_used |= a.bit();
             }

@@ -62,16 +62,7 @@ pub fn report_summary(cmd: &str, name: &str, s: &Summary) {
         return;
     }
     let mut err = std::io::stderr().lock();
-    for w in &s.warnings {
-        let _ = writeln!(err, "verne {cmd}: {name}: warning: {w}");
-    }
-    if s.warnings_dropped > 0 {
-        let _ = writeln!(
-            err,
-            "verne {cmd}: {name}: {} more warnings not shown",
-            s.warnings_dropped
-        );
-    }
+    crate::input::write_warnings(&mut err, cmd, name, &s.warnings, s.warnings_dropped);
     let mut line = format!(
         "verne {cmd}: {name}: {} rows from {} blocks (G-code, {}, axes {})",
         s.rows,

@@ -7,3 +7,23 @@ pub mod cl;
 pub mod gcode;
 pub mod resample;
 pub mod verify_files;
+
+/// A reader's warnings on stderr, `verne CMD: NAME: warning: ...`, and how many it stopped
+/// keeping: nothing a reader saw is dropped silently.
+pub fn write_warnings(
+    err: &mut impl std::io::Write,
+    cmd: &str,
+    name: &str,
+    warnings: &[impl std::fmt::Display],
+    dropped: u64,
+) {
+    for w in warnings {
+        let _ = writeln!(err, "verne {cmd}: {name}: warning: {w}");
+    }
+    if dropped > 0 {
+        let _ = writeln!(
+            err,
+            "verne {cmd}: {name}: {dropped} more warnings not shown"
+        );
+    }
+}
