@@ -8,7 +8,7 @@
 //! diff).
 //!
 //! What is filtered, deliberately, because it depends on the machine's speed or load rather than
-//! on the code (see [`filter`]): the elapsed time in `verne selftest`'s first line, the `time`
+//! on the code (see [`common::filter_timing`]): the elapsed time in `verne selftest`'s first line, the `time`
 //! line of each `verne workspace` summary (seconds, points per second, threads), and the
 //! `time_s` column of the volume-against-tool-length table. Paths under the scratch directory
 //! are written as `$OUT`. Nothing else is filtered.
@@ -69,44 +69,6 @@ fn cases(root: &Path) -> Vec<Case> {
     out
 }
 
-/// Replaces what depends on the machine's speed, load or the scratch directory (module doc).
-fn filter(bytes: &[u8], scratch: &str) -> Vec<u8> {
-    let text = String::from_utf8_lossy(bytes).replace(scratch, "$OUT");
-    let mut out = String::with_capacity(text.len());
-    let mut in_time_table = false;
-    for line in text.split_inclusive('\n') {
-        let (body, end) = match line.strip_suffix('\n') {
-            Some(b) => (b, "\n"),
-            None => (line, ""),
-        };
-        let filtered = if body.starts_with("selftest of machine ") && body.ends_with(" s)") {
-            // "... (4.6 s)": the run's elapsed time.
-            match body.rfind(" (") {
-                Some(k) => format!("{} (<time> s)", &body[..k]),
-                None => body.to_string(),
-            }
-        } else if body.trim_start().starts_with("time ") && body.starts_with("  time") {
-            // The workspace summary's "time  0.76 s, 12845 points/s, 2 threads".
-            "  time               <filtered>".to_string()
-        } else if body.starts_with("tool_length_mm") && body.ends_with("time_s") {
-            in_time_table = true;
-            body.to_string()
-        } else if in_time_table && !body.trim().is_empty() {
-            // The last column of the volume-against-tool-length table is seconds.
-            match body.trim_end().rfind(' ') {
-                Some(k) => format!("{} <t>", &body[..k]),
-                None => body.to_string(),
-            }
-        } else {
-            in_time_table = false;
-            body.to_string()
-        };
-        out.push_str(&filtered);
-        out.push_str(end);
-    }
-    out.into_bytes()
-}
-
 fn run(case: &Case, scratch: &Path) -> Outcome {
     let _ = fs::remove_dir_all(scratch);
     fs::create_dir_all(scratch).unwrap();
@@ -136,8 +98,8 @@ fn run(case: &Case, scratch: &Path) -> Outcome {
         .collect();
     files.sort();
     Outcome {
-        stdout: filter(&out.stdout, &scratch_text),
-        stderr: filter(&out.stderr, &scratch_text),
+        stdout: common::filter_timing(&out.stdout, &scratch_text),
+        stderr: common::filter_timing(&out.stderr, &scratch_text),
         code: match out.status.code() {
             Some(c) => format!("{c}\n"),
             None => "signal\n".to_string(),

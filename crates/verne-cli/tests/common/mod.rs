@@ -67,3 +67,52 @@ pub fn col(header: &[String], name: &str) -> usize {
 pub fn num(s: &str) -> f64 {
     s.parse().unwrap_or_else(|_| panic!("not a number: {s:?}"))
 }
+
+/// Replaces what depends on the machine's speed, load or the scratch directory: the elapsed time
+/// in `verne selftest`'s first line, the `time` line of a `verne workspace` summary, a sweep's
+/// progress lines and the `time_s` column of its volume-against-tool-length table; `scratch` is written `$OUT`.
+pub fn filter_timing(bytes: &[u8], scratch: &str) -> Vec<u8> {
+    let text = String::from_utf8_lossy(bytes).replace(scratch, "$OUT");
+    let mut out = String::with_capacity(text.len());
+    let mut in_time_table = false;
+    for line in text.split_inclusive('\n') {
+        let (body, end) = match line.strip_suffix('\n') {
+            Some(b) => (b, "\n"),
+            None => (line, ""),
+        };
+        let filtered = if body.starts_with("selftest of machine ") && body.ends_with(" s)") {
+            // "... (4.6 s)": the run's elapsed time.
+            match body.rfind(" (") {
+                Some(k) => format!("{} (<time> s)", &body[..k]),
+                None => body.to_string(),
+            }
+        } else if body.starts_with("verne workspace: ")
+            && body.ends_with(" s")
+            && body.contains(" l in ")
+        {
+            // A sweep's progress line "verne workspace: tool.length=0: 453.962 l in 9.1 s".
+            match body.rfind(" in ") {
+                Some(k) => format!("{} in <time> s", &body[..k]),
+                None => body.to_string(),
+            }
+        } else if body.trim_start().starts_with("time ") && body.starts_with("  time") {
+            // The workspace summary's "time  0.76 s, 12845 points/s, 2 threads".
+            "  time               <filtered>".to_string()
+        } else if body.starts_with("tool_length_mm") && body.ends_with("time_s") {
+            in_time_table = true;
+            body.to_string()
+        } else if in_time_table && !body.trim().is_empty() {
+            // The last column of the volume-against-tool-length table is seconds.
+            match body.trim_end().rfind(' ') {
+                Some(k) => format!("{} <t>", &body[..k]),
+                None => body.to_string(),
+            }
+        } else {
+            in_time_table = false;
+            body.to_string()
+        };
+        out.push_str(&filtered);
+        out.push_str(end);
+    }
+    out.into_bytes()
+}
