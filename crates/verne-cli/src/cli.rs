@@ -41,9 +41,10 @@ pub enum Command {
         after_help = "Examples:\n  verne ik data/example.cl | verne fk              the tool poses back from the joints\n  verne fk --machine-joints 314.12,260.78,260.60,0,0  one row of machine joints\n  verne fk --all --radians --joints 674,685,250    every assembly mode of three sliders\n\nInputs: machine joints rho1,rho2,rho3 (mm), theta1,theta2 (output adds x,y,z,i,j,k,phi1,phi2,\nstatus); slider rows rho1,rho2,rho3 (output adds xp,yp,zp,alpha,status). --all: one row per\nreal assembly mode.\n\nExit codes: 0 all rows ok, 1 some row not ok, 2 fatal."
     )]
     Fk(FkArgs),
-    /// Every branch of one query, with its verdict, as a table for a person (or --csv).
+    /// Every branch of one query (a tool pose, machine joints, a platform point or sliders) with
+    /// its verdict and Jacobian figures, as a table for a person (or --csv).
     #[command(
-        after_help = "Example:\n  verne modes --joints 674,685,250\n  verne modes --pose=-240,-86,1000 --csv"
+        after_help = "Examples:\n  verne modes --tool 80,0,30,0.342020,0,0.939693      every branch of one tool pose (5-axis)\n  verne modes --machine-joints 367.64,320.86,307.56,-20.34,-90  every assembly mode of machine joints\n  verne modes --joints 674,685,250 --plot modes.svg   the four assembly modes of Table III, drawn\n  verne modes --pose=-240,-86,1000 --csv              every inverse branch of a platform point\n\nColumns: the branch's joints (or pose), its configuration s1,s2,s3, working, det A, the extreme\nvelocity amplification factors, the parallel and serial singularity margins, and the status\n(ok, or every check that fails). The title says whether the list is proved complete.\n\nExit codes: 0 some real branch, 1 none (unreachable), 2 fatal."
     )]
     Modes(ModesArgs),
     /// Compare the glider architectures (Wenger 2001): Tables 1 and 2, paper beside computed.
@@ -178,12 +179,23 @@ pub struct FkArgs {
 
 #[derive(Debug, Args)]
 pub struct ModesArgs {
-    /// A platform point XP,YP,ZP: every inverse branch.
-    #[arg(long, value_name = "XP,YP,ZP", value_parser = parse_point, required_unless_present = "joints", conflicts_with = "joints")]
+    /// A platform point XP,YP,ZP: every inverse branch of the parallel module.
+    #[arg(long, value_name = "XP,YP,ZP", value_parser = parse_point, required_unless_present_any = ["joints", "tool", "machine_joints"], conflicts_with_all = ["joints", "tool", "machine_joints"])]
     pub pose: Option<[f64; 3]>,
-    /// Slider positions R1,R2,R3: every assembly mode.
-    #[arg(long, value_name = "R1,R2,R3", value_parser = parse_point)]
+    /// Slider positions R1,R2,R3: every assembly mode of the parallel module.
+    #[arg(long, value_name = "R1,R2,R3", value_parser = parse_point, conflicts_with_all = ["tool", "machine_joints"])]
     pub joints: Option<[f64; 3]>,
+    /// A tool pose X,Y,Z,I,J,K (tip in mm and tool axis, workpiece frame): every branch of the
+    /// 5-axis machine over both orientation solutions of the axis.
+    #[arg(long, value_name = "X,Y,Z,I,J,K", value_parser = parse_tool_pose, allow_hyphen_values = true, conflicts_with = "machine_joints")]
+    pub tool: Option<[f64; 6]>,
+    /// Machine joints R1,R2,R3,T1,T2 (mm, and degrees unless --radians): every assembly mode of
+    /// the 5-axis machine, with its tool pose.
+    #[arg(long, value_name = "R1,R2,R3,T1,T2", value_parser = parse_machine_joints, allow_hyphen_values = true)]
+    pub machine_joints: Option<[f64; 5]>,
+    /// Tool length Delta (mm) for --tool and --machine-joints, overriding the machine file's.
+    #[arg(long, value_name = "MM", value_parser = parse_positive)]
+    pub tool_length: Option<f64>,
     /// CSV for a script instead of an aligned table.
     #[arg(long)]
     pub csv: bool,
