@@ -220,7 +220,7 @@ fn fk_all_writes_both_assembly_modes_and_reports_structural_singularity() {
     assert_eq!(
         t.header,
         [
-            "rho1", "rho2", "branch", "assembly", "mode", "x", "y", "working", "status"
+            "rho1", "rho2", "branch", "mode", "assembly", "x", "y", "working", "status"
         ]
     );
     assert_eq!(t.rows.len(), 3);
@@ -253,7 +253,8 @@ fn exit_codes_follow_the_contract() {
     // 0: every row ok.
     let ok = run(&["ik", "-m", "orthoglide", "--pose", "0.98,1.5,0"], None);
     assert_eq!(ok.status.code(), Some(0));
-    // 1: a row outside the joint ranges still yields its joints, with a status.
+    // 1: a row outside the joint ranges: its status, its cells empty as for the VERNE machine
+    // (docs/csv.md); --all writes them.
     let out = run(
         &["ik", "-m", "orthoglide"],
         Some("x,y\n0.98,1.5\n0.98,1.9\n"),
@@ -263,8 +264,22 @@ fn exit_codes_follow_the_contract() {
     assert_eq!(t.rows.len(), 2);
     assert_eq!(t.get(&t.rows[0], "status"), "ok");
     assert!(t.get(&t.rows[1], "status").contains("range"));
-    assert!(!t.get(&t.rows[1], "rho1").is_empty());
+    assert!(t.get(&t.rows[1], "rho1").is_empty() && t.get(&t.rows[1], "rho2").is_empty());
     assert!(stderr(&out).contains("1 of 2 rows not ok"));
+    let all = run(
+        &["ik", "-m", "orthoglide", "--all"],
+        Some("x,y\n0.98,1.9\n"),
+    );
+    let t = Table::of(&all);
+    let first = &t.rows[0];
+    assert_eq!(t.get(first, "mode"), "++");
+    assert!(t.get(first, "status").contains("range") && !t.get(first, "rho1").is_empty());
+    // fk the same: a mode outside the ranges is written by --all only.
+    let fk = run(&["fk", "-m", "orthoglide"], Some("rho1,rho2\n1.9,0.1\n"));
+    assert_eq!(fk.status.code(), Some(1));
+    let t = Table::of(&fk);
+    assert!(t.get(&t.rows[0], "status").contains("rho1_range"));
+    assert!(t.get(&t.rows[0], "x").is_empty());
     // 2: a non-zero third value, a missing column, a malformed cell.
     let planar = run(&["ik", "-m", "biglide2", "--pose", "1,2,3"], None);
     assert_eq!(planar.status.code(), Some(2));
@@ -507,4 +522,57 @@ fn the_mechanism_is_resolved_once_and_its_options_checked() {
     let v = run(&["ik", "--pose", "1,2"], None);
     assert_eq!(v.status.code(), Some(2));
     assert!(stderr(&v).contains("needs XP,YP,ZP"), "{}", stderr(&v));
+}
+
+#[test]
+fn modes_plot_draws_every_branch_of_a_glider() {
+    let dir = std::env::temp_dir().join(format!("verne-glider-modes-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (args, panels) in [
+        (vec!["modes", "-m", "biglide1", "--pose", "0.97,0.5"], 4),
+        (vec!["modes", "-m", "orthoglide", "--joints", "0.5,0.5"], 2),
+    ] {
+        let svg = dir.join("modes.svg");
+        let mut a = args.clone();
+        a.extend(["--plot", svg.to_str().unwrap()]);
+        let out = run(&a, None);
+        assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+        let picture = std::fs::read_to_string(&svg).unwrap();
+        assert_eq!(picture.matches(": mode ").count(), panels, "{args:?}");
+        assert!(picture.contains("mode ++, assembly +"));
+        assert!(picture.contains("x (L)") && picture.contains("strut CP"));
+        std::fs::remove_file(&svg).unwrap();
+    }
+    // PNG too, and a glider workspace in PNG.
+    let png = dir.join("modes.png");
+    let out = run(
+        &[
+            "modes",
+            "-m",
+            "biglide2",
+            "--pose",
+            "0.2,1.2",
+            "--plot",
+            png.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
+    let ws = dir.join("ws.png");
+    let out = run(
+        &[
+            "workspace",
+            "-m",
+            "biglide2",
+            "--step",
+            "0.05",
+            "--plot",
+            ws.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    assert!(std::fs::read(&ws).unwrap().starts_with(b"\x89PNG"));
+    let _ = std::fs::remove_dir_all(&dir);
 }

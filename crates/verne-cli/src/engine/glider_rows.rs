@@ -81,7 +81,8 @@ impl RowJob for GliderIk {
         };
         let v = verdict(&self.spec, *p, s.rho, s.mode, s.assembly);
         let status = Cell::Str(v.as_str());
-        out.row(&[Cell::Num(s.rho.x), Cell::Num(s.rho.y), status])?;
+        let [a, b] = ok_cells(&v, [s.rho.x, s.rho.y]);
+        out.row(&[a, b, status])?;
         Ok(RowOutcome { ok: v.ok(), status })
     }
 }
@@ -103,7 +104,7 @@ pub struct FkSolved {
 
 const FK_INPUTS: &[(&str, bool)] = &[("rho1", false), ("rho2", false)];
 const FK_OUT: &[&str] = &["x", "y", "status"];
-const FK_OUT_ALL: &[&str] = &["branch", "assembly", "mode", "x", "y", "working", "status"];
+const FK_OUT_ALL: &[&str] = &["branch", "mode", "assembly", "x", "y", "working", "status"];
 
 impl RowJob for GliderFk {
     type Solved = FkSolved;
@@ -160,7 +161,7 @@ impl RowJob for GliderFk {
         if self.all {
             for (k, f) in sols.iter().enumerate() {
                 let v = verdict(&self.spec, f.p, rho, f.mode, f.assembly);
-                let labels = [branch_label(f.assembly), mode_label(f.mode)];
+                let labels = [mode_label(f.mode), branch_label(f.assembly)];
                 branch_row(out, k, labels, [f.p.x, f.p.y], v)?;
             }
             return Ok(RowOutcome {
@@ -177,12 +178,24 @@ impl RowJob for GliderFk {
         };
         let v = verdict(&self.spec, f.p, rho, f.mode, f.assembly);
         let status = Cell::Str(v.as_str());
-        out.row(&[Cell::Num(f.p.x), Cell::Num(f.p.y), status])?;
+        let [a, b] = ok_cells(&v, [f.p.x, f.p.y]);
+        out.row(&[a, b, status])?;
         Ok(RowOutcome { ok: v.ok(), status })
     }
 }
 
-/// One `--all` row: `branch`, two labels, two values, `working`, `status`.
+/// The computed cells of a default (one-solution) row: filled when it is ok, empty otherwise,
+/// the status saying why (the contract of the VERNE machine's rows, docs/csv.md); `--all` fills
+/// every branch.
+fn ok_cells(v: &Verdict, values: [f64; 2]) -> [Cell; 2] {
+    if v.ok() {
+        values.map(Cell::Num)
+    } else {
+        [Cell::Empty, Cell::Empty]
+    }
+}
+
+/// One `--all` row: `branch`, `mode`, `assembly`, two values, `working`, `status`.
 pub(crate) fn branch_row(
     out: &mut RowWriter<'_>,
     k: usize,

@@ -1,13 +1,11 @@
 //! Pictures (SVG or PNG, by the file's extension, drawn with plotters): workspace slices and
 //! projections coloured by binding constraint, and schematics of the branches of one query
-//! (sliders, rods, platform; compare Figs. 5-6, AIM 2007); the glider workspace's SVG is in
+//! (sliders, rods, platform; compare Figs. 5-6, AIM 2007); the gliders' pictures are in
 //! [`glider`].
 //!
 //! Files are written to a temporary file beside the target and renamed into place. PNG text is
 //! drawn with DejaVu Sans, embedded from `assets/fonts/` (Bitstream Vera licence, which allows
 //! redistribution with software; see `assets/fonts/LICENSE-DejaVu.txt`).
-
-pub mod glider;
 
 use std::path::{Path, PathBuf};
 use std::sync::Once;
@@ -137,6 +135,8 @@ macro_rules! render {
         }
     }};
 }
+
+pub mod glider;
 
 /// A panel of a workspace picture: a slice through the grid or a projection along an axis.
 #[derive(Debug, Clone, Copy, PartialEq)]

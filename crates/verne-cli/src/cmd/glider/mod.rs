@@ -10,9 +10,9 @@ use std::path::Path;
 use nalgebra::{Point2, Vector2};
 use verne::glider::jacobian::singular_values_2x2;
 use verne::glider::{
-    ForwardKinematics, GliderSpec, PAPER_LAMBDA_BOUNDS, amplification, branch_label, det_a, det_b,
-    forward_kinematics, inverse_kinematics, is_parallel_singular, is_serial_singular, jacobians,
-    mode_label, verdict,
+    ForwardKinematics, GliderSpec, PAPER_LAMBDA_BOUNDS, Verdict, amplification, branch_label,
+    det_a, det_b, forward_kinematics, inverse_kinematics, is_parallel_singular, is_serial_singular,
+    jacobians, mode_label, verdict,
 };
 
 pub mod workspace;
@@ -24,6 +24,7 @@ use crate::cli::{FkArgs, IkArgs, ModesArgs};
 use crate::engine::glider_rows::{GliderFk, GliderIk, MAX_STRUCTURAL_REPORTS};
 use crate::engine::pipeline::{Cell, Units, write_cell};
 use crate::error::VerneError;
+use crate::plot::glider::{GliderSketch, branches_picture};
 use crate::report::text_table::{aligned, csv_text};
 use crate::table::CsvSource;
 
@@ -191,6 +192,17 @@ pub fn modes(args: &ModesArgs, spec: GliderSpec) -> Result<u8, VerneError> {
     let third = planar;
     let mut header: Vec<&str>;
     let mut rows: Vec<Vec<Cell>> = Vec::new();
+    let mut sketches: Vec<GliderSketch> = Vec::new();
+    let mut sketch =
+        |k: usize, p: Point2<f64>, rho: Vector2<f64>, labels: [&str; 2], v: &Verdict| {
+            sketches.push(GliderSketch {
+                p,
+                rho,
+                label: format!("{}: mode {}, assembly {}", k + 1, labels[0], labels[1]),
+                detail: v.as_str().to_string(),
+                working: v.ok(),
+            })
+        };
     let title;
     if let Some(q) = args.pose {
         third(q, "--pose")?;
@@ -209,6 +221,13 @@ pub fn modes(args: &ModesArgs, spec: GliderSpec) -> Result<u8, VerneError> {
             r.extend(kinetostatic_cells(&spec, p, s.rho));
             r.extend([Cell::Bool(v.ok()), Cell::Str(v.as_str())]);
             rows.push(r);
+            sketch(
+                k,
+                p,
+                s.rho,
+                [mode_label(s.mode), branch_label(s.assembly)],
+                &v,
+            );
         }
         title = format!(
             "{}: inverse kinematics of P = ({}, {}): {} real working modes",
@@ -221,7 +240,7 @@ pub fn modes(args: &ModesArgs, spec: GliderSpec) -> Result<u8, VerneError> {
         let j = args.joints.unwrap_or([0.0; 3]);
         third(j, "--joints")?;
         let rho = Vector2::new(j[0], j[1]);
-        header = vec!["branch", "assembly", "mode", "x", "y"];
+        header = vec!["branch", "mode", "assembly", "x", "y"];
         match forward_kinematics(&spec, rho) {
             ForwardKinematics::StructuralSingularity { centre, radius } => {
                 title = format!(
@@ -235,14 +254,21 @@ pub fn modes(args: &ModesArgs, spec: GliderSpec) -> Result<u8, VerneError> {
                     let v = verdict(&spec, f.p, rho, f.mode, f.assembly);
                     let mut r = vec![
                         Cell::Int(k as i64 + 1),
-                        Cell::Str(branch_label(f.assembly)),
                         Cell::Str(mode_label(f.mode)),
+                        Cell::Str(branch_label(f.assembly)),
                         Cell::Num(f.p.x),
                         Cell::Num(f.p.y),
                     ];
                     r.extend(kinetostatic_cells(&spec, f.p, rho));
                     r.extend([Cell::Bool(v.ok()), Cell::Str(v.as_str())]);
                     rows.push(r);
+                    sketch(
+                        k,
+                        f.p,
+                        rho,
+                        [mode_label(f.mode), branch_label(f.assembly)],
+                        &v,
+                    );
                 }
                 title = format!(
                     "{}: forward kinematics of rho = ({}, {}): {} real assembly modes",
@@ -277,6 +303,10 @@ pub fn modes(args: &ModesArgs, spec: GliderSpec) -> Result<u8, VerneError> {
         t
     };
     write_stdout(&text)?;
+    if let Some(path) = &args.plot {
+        branches_picture(path, &spec, &title, &sketches)
+            .map_err(|e| VerneError::io(&path.display().to_string(), std::io::Error::other(e)))?;
+    }
     Ok(if rows.is_empty() {
         EXIT_ROWS_FAILED
     } else {

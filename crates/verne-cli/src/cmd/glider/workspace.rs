@@ -13,7 +13,7 @@ use verne::glider::{
 use crate::cmd::{EXIT_OK, EXIT_ROWS_FAILED};
 use crate::engine::pipeline::{Cell, Units, write_cell};
 use crate::error::VerneError;
-use crate::plot::glider::workspace_svg;
+use crate::plot::glider::workspace_picture;
 use crate::table::Sink;
 
 /// Default grid nodes along the longer side of the workspace window.
@@ -51,7 +51,7 @@ fn class_code(c: NodeClass) -> &'static str {
 ///   for the paper's 1/3 < lambda < 3), `None` for none.
 /// - `output`: the points CSV ([`WORKSPACE_HEADER`], one row per node, y slowest), written
 ///   atomically; `None` writes no points, `-` writes stdout.
-/// - `plot`: an SVG picture of the workspace, the region, the rectangle and the guides.
+/// - `plot`: a picture (SVG or PNG) of the workspace, the region, the rectangle and the guides.
 ///
 /// The summary goes to stderr. Returns exit code 0, or 1 when the region is empty.
 pub fn workspace(
@@ -70,13 +70,8 @@ pub fn workspace(
             "lambda bounds {lo},{hi}: expected 0 < LO < HI"
         )));
     }
-    if let Some(p) = plot
-        && !p.extension().is_some_and(|e| e.eq_ignore_ascii_case("svg"))
-    {
-        return Err(VerneError::Usage(format!(
-            "{}: a glider workspace is plotted as SVG; give a file name ending in .svg",
-            p.display()
-        )));
+    if let Some(p) = plot {
+        crate::plot::Format::of_path(p).map_err(VerneError::Usage)?;
     }
     let base = WorkspaceOptions {
         lambda_bounds,
@@ -144,7 +139,8 @@ pub fn workspace(
         write_workspace_points(spec, &grid, &opts, out, units)?;
     }
     if let Some(p) = plot {
-        write_atomic(p, &workspace_svg(spec, &grid, rect, square))?;
+        workspace_picture(p, spec, &grid, rect, square)
+            .map_err(|e| VerneError::io(&p.display().to_string(), std::io::Error::other(e)))?;
     }
 
     let cell = grid.step * grid.step;
@@ -276,12 +272,6 @@ fn write_workspace_points(
     sink.finish()
 }
 
-/// Writes text to `path` as every output file is written ([`crate::table::write_output`]).
-fn write_atomic(path: &Path, text: &str) -> Result<(), VerneError> {
-    crate::table::write_output(path, text.as_bytes())
-        .map_err(|e| VerneError::io(&path.display().to_string(), e))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -320,7 +310,14 @@ mod tests {
         assert!(rows.iter().any(|r| r.contains(",unreachable,")));
         let picture = std::fs::read_to_string(&svg).unwrap();
         assert!(picture.starts_with("<svg") && picture.trim_end().ends_with("</svg>"));
-        assert!(picture.contains("<polygon"));
+        // Axes in the preset's unit, a legend, one outline for S (the orthoglide's S is its
+        // largest square).
+        assert!(
+            picture.contains("x (L)") && picture.contains("y (L)"),
+            "axes"
+        );
+        assert!(picture.contains("S = largest square"), "legend");
+        assert!(!picture.contains("largest square (dashed)"));
         // No temporary file is left beside the outputs.
         let names: Vec<_> = std::fs::read_dir(&dir).unwrap().collect();
         assert_eq!(names.len(), 2);
@@ -344,16 +341,16 @@ mod tests {
         assert!(both.unwrap_err().to_string().contains("not both"));
         let tiny = workspace(&spec, Some(1e-9), None, None, None, None, Units::default());
         assert!(tiny.unwrap_err().to_string().contains("larger step"));
-        let png = workspace(
+        let gif = workspace(
             &spec,
             None,
             Some(11),
             None,
             None,
-            Some(Path::new("w.png")),
+            Some(Path::new("w.gif")),
             Units::default(),
         );
-        assert!(png.unwrap_err().to_string().contains(".svg"));
+        assert!(gif.unwrap_err().to_string().contains(".svg or .png"));
         let bounds = workspace(
             &spec,
             None,
