@@ -574,5 +574,20 @@ fn modes_plot_draws_every_branch_of_a_glider() {
     );
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
     assert!(std::fs::read(&ws).unwrap().starts_with(b"\x89PNG"));
+    // The orthoglide's S is its largest square: one outline, named so (they overlapped).
+    let svg = dir.join("ortho.svg");
+    let out = run(
+        &[
+            "workspace",
+            "-m",
+            "orthoglide",
+            "--plot",
+            svg.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let picture = std::fs::read_to_string(&svg).unwrap();
+    assert!(picture.contains("S = largest square") && !picture.contains("(dashed)"));
     let _ = std::fs::remove_dir_all(&dir);
 }
