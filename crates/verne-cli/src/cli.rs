@@ -79,8 +79,7 @@ pub enum Command {
         /// The shell.
         shell: clap_complete::Shell,
     },
-    /// Print the man page (roff), as kept in docs/verne.1.
-    #[command(hide = true)]
+    /// Print the man page (roff), as kept in docs/verne.1: `verne manpage > verne.1`.
     Manpage,
 }
 

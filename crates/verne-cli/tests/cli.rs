@@ -304,6 +304,10 @@ fn modes_plot_draws_every_branch() {
     assert_eq!(out.status.code(), Some(0));
     let svg = std::fs::read_to_string(&f).unwrap();
     assert!(svg.contains("<svg"));
+    // A legend for the legs (colours alone said nothing).
+    for leg in ["leg I: two rods", "leg II", "leg III", "guideways"] {
+        assert!(svg.contains(leg), "legend entry {leg} missing");
+    }
     for k in 1..=4 {
         assert!(svg.contains(&format!("{k}: s=(")), "panel {k} missing");
     }
@@ -468,4 +472,36 @@ fn prefer_is_honoured_where_a_vertical_start_decides_and_theta2_does_not_swing()
     let out = run(&["ik", "--prefer", "orientation2"], Some(&example));
     let (h, rows) = table(&out);
     assert_eq!(rows[0][col(&h, "theta2")], "0");
+}
+
+/// A joint list (halstreamer, G-code) stops at a row it cannot solve: to a file nothing is
+/// written; to stdout the rows before it may already be in the pipe, and the error says so.
+#[test]
+fn a_stopped_joint_list_on_stdout_is_called_incomplete() {
+    let path = "x,y,z,i,j,k\n0,0,150,0,0,1\n5000,0,0,0,0,1\n";
+    let out = run(&["ik", "--format", "halstreamer"], Some(path));
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("<stdin>:3") && err.contains("incomplete"),
+        "{err}"
+    );
+    let dir = std::env::temp_dir().join(format!("verne-stopped-list-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("joints.hal");
+    let out = run(
+        &[
+            "ik",
+            "--format",
+            "halstreamer",
+            "-o",
+            file.to_str().unwrap(),
+        ],
+        Some(path),
+    );
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("incomplete"), "{err}");
+    assert!(!file.exists());
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -167,8 +167,17 @@ pub fn run_rows<J: RowJob>(
     }
     let summary = match result {
         Ok(s) => s,
-        Err(e) => {
+        Err(mut e) => {
             sink.discard();
+            let to_stdout = output.is_none_or(|p| p.as_os_str() == "-");
+            if let (true, true, VerneError::Input { message, .. }) =
+                (units.every_row_needed(), to_stdout, &mut e)
+            {
+                // A file is never left partial; a pipe may have received the rows before.
+                message.push_str(
+                    "; the rows before it went to stdout as they were solved: that list is incomplete, do not play it (-o FILE writes nothing on such an error)",
+                );
+            }
             return Err(e);
         }
     };

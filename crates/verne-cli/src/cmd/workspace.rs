@@ -351,6 +351,17 @@ pub fn run(args: &WorkspaceArgs) -> Result<u8, VerneError> {
             let views: Vec<View> = if args.slice.is_empty() {
                 plot::default_views(&ws.summary)
             } else {
+                let g = &ws.map.grid;
+                for &(axis, value) in &args.slice {
+                    let (lo, hi) = (g.coord(axis, 0), g.coord(axis, g.n[axis] - 1));
+                    if value < lo - 0.5 * g.step || value > hi + 0.5 * g.step {
+                        let nearest = if value < lo { lo } else { hi };
+                        let name = ["x", "y", "z"][axis];
+                        sayln!(
+                            "verne workspace: --slice {name}={value} is outside the grid ({name} from {lo} to {hi} mm): the nearest slice, {name} = {nearest} mm, is drawn"
+                        );
+                    }
+                }
                 let mut v: Vec<View> = args
                     .slice
                     .iter()

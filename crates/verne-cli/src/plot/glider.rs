@@ -11,7 +11,10 @@ use plotters::prelude::*;
 use plotters::series::DashedLineSeries;
 use verne::glider::{GliderSpec, NodeClass, Rectangle as Region, WorkspaceGrid};
 
-use super::{FAMILY, Format, io_err, register_font, temp_path_keeping_extension};
+use super::{
+    FAMILY, Format, draw_title_and_legend, drawing, io_err, register_font,
+    temp_path_keeping_extension,
+};
 use std::path::Path;
 
 /// Width of the workspace chart's plotting area (px).
@@ -69,41 +72,6 @@ fn equal_scale_height(width_px: u32, ((x0, x1), (y0, y1)): ((f64, f64), (f64, f6
     ((width_px as f64) * (y1 - y0) / (x1 - x0))
         .round()
         .clamp(120.0, 2000.0) as u32
-}
-
-fn drawing<E: std::fmt::Display>(e: E) -> String {
-    format!("drawing: {e}")
-}
-
-/// Legend entries, in a row (wrapping), under the title: (swatch, outline only, label).
-fn draw_title_and_legend<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    title: &str,
-    entries: &[(RGBColor, bool, String)],
-) -> Result<(), String> {
-    let (width, _) = area.dim_in_pixel();
-    area.draw(&Text::new(title.to_string(), (10, 8), (FAMILY, 15)))
-        .map_err(drawing)?;
-    let (mut x, mut y) = (10, 36);
-    for (colour, outline, label) in entries {
-        let w = 30 + 7 * label.len() as i32;
-        if x + w > width as i32 - 10 && x > 10 {
-            (x, y) = (10, y + 22);
-        }
-        let swatch = [(x, y), (x + 14, y + 14)];
-        if *outline {
-            area.draw(&Rectangle::new(swatch, colour.stroke_width(2)))
-                .map_err(drawing)?;
-        } else {
-            area.draw(&Rectangle::new(swatch, colour.filled()))
-                .map_err(drawing)?;
-            area.draw(&Rectangle::new(swatch, BLACK)).map_err(drawing)?;
-        }
-        area.draw(&Text::new(label.clone(), (x + 20, y), (FAMILY, 13)))
-            .map_err(drawing)?;
-        x += w;
-    }
-    Ok(())
 }
 
 /// A chart over the window with axes, ticks and the unit.

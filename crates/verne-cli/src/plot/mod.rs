@@ -138,6 +138,41 @@ macro_rules! render {
 
 pub mod glider;
 
+fn drawing<E: std::fmt::Display>(e: E) -> String {
+    format!("drawing: {e}")
+}
+
+/// Legend entries, in a row (wrapping), under the title: (swatch, outline only, label).
+fn draw_title_and_legend<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    title: &str,
+    entries: &[(RGBColor, bool, String)],
+) -> Result<(), String> {
+    let (width, _) = area.dim_in_pixel();
+    area.draw(&Text::new(title.to_string(), (10, 8), (FAMILY, 15)))
+        .map_err(drawing)?;
+    let (mut x, mut y) = (10, 36);
+    for (colour, outline, label) in entries {
+        let w = 30 + 7 * label.len() as i32;
+        if x + w > width as i32 - 10 && x > 10 {
+            (x, y) = (10, y + 22);
+        }
+        let swatch = [(x, y), (x + 14, y + 14)];
+        if *outline {
+            area.draw(&Rectangle::new(swatch, colour.stroke_width(2)))
+                .map_err(drawing)?;
+        } else {
+            area.draw(&Rectangle::new(swatch, colour.filled()))
+                .map_err(drawing)?;
+            area.draw(&Rectangle::new(swatch, BLACK)).map_err(drawing)?;
+        }
+        area.draw(&Text::new(label.clone(), (x + 20, y), (FAMILY, 13)))
+            .map_err(drawing)?;
+        x += w;
+    }
+    Ok(())
+}
+
 /// A panel of a workspace picture: a slice through the grid or a projection along an axis.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum View {
@@ -424,7 +459,7 @@ pub fn branches_picture(
     let n = branches.len().max(1);
     let cols = n.min(4);
     let rows = n.div_ceil(4);
-    let size = (340 * cols as u32, 380 * rows as u32 + 40);
+    let size = (340 * cols as u32, 380 * rows as u32 + BRANCH_LEGEND_PX);
     // Common window: every attachment of every branch plus the guideways.
     let g = &m.module;
     let mut ys = vec![-g.r4, g.r4, -g.r_small1, g.r_small1];
@@ -460,9 +495,8 @@ pub fn branches_picture(
         |root: &DrawingArea<_, Shift>| -> Result<(), String> {
             let e = |e| format!("drawing: {e}");
             root.fill(&WHITE).map_err(e)?;
-            let (top, body) = root.split_vertically(40);
-            top.draw(&Text::new(title.to_string(), (10, 10), (FAMILY, 16)))
-                .map_err(e)?;
+            let (top, body) = root.split_vertically(BRANCH_LEGEND_PX);
+            draw_title_and_legend(&top, title, &branch_legend())?;
             let panels = body.split_evenly((rows, cols));
             for (panel, b) in panels.iter().zip(branches) {
                 draw_branch(panel, m, b, (y0, y1), (z0, z1))?;
@@ -470,6 +504,31 @@ pub fn branches_picture(
             Ok(())
         }
     )
+}
+
+/// Height of the title and legend band of a branches picture (px).
+const BRANCH_LEGEND_PX: u32 = 62;
+/// Colours of the legs in a branches picture: leg I (two rods), leg II, leg III.
+const LEG_COLOURS: [RGBColor; 3] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+];
+
+/// The legend of a branches picture: the legs, the platform, the guideways, the working frame.
+fn branch_legend() -> Vec<(RGBColor, bool, String)> {
+    vec![
+        (LEG_COLOURS[0], false, "leg I: two rods, slider 1".into()),
+        (LEG_COLOURS[1], false, "leg II: slider 2".into()),
+        (LEG_COLOURS[2], false, "leg III: slider 3".into()),
+        (BLACK, false, "platform and P".into()),
+        (
+            RGBColor(150, 150, 150),
+            true,
+            "guideways over the strokes (dashed)".into(),
+        ),
+        (RGBColor(46, 160, 67), true, "the working branch".into()),
+    ]
 }
 
 /// Slider attachment A and platform attachment B of the four rods of eqs. (3)-(6).
@@ -560,10 +619,10 @@ fn draw_branch<DB: DrawingBackend>(
     }
     let att = attachments(m, &b.pose, &b.rho);
     let colors = [
-        RGBColor(31, 119, 180),
-        RGBColor(31, 119, 180),
-        RGBColor(214, 39, 40),
-        RGBColor(44, 160, 44),
+        LEG_COLOURS[0],
+        LEG_COLOURS[0],
+        LEG_COLOURS[1],
+        LEG_COLOURS[2],
     ];
     for ((a, bb), col) in att.iter().zip(colors) {
         chart
