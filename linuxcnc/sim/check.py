@@ -15,7 +15,9 @@ period). For `ok`:
      (distance in X, Y, Z in mm and A, C in degrees, taken together);
   4. `verne verify` of the recording (every 10th row, t from the servo period) against the
      nearest programmed poses is clean, with tip_error_mm and axis_error_deg set to the
-     blending tolerance.
+     blending tolerance;
+  5. `verne verify --recording` of every sample as recorded (tag, joints, two more pins)
+     against the program's points is clean with the same tolerance.
 For `unreachable`: LinuxCNC refuses the move with the kinematics error, motion never starts it,
 the joints never jump, and the machine stops at a pose it can hold.
 Exits non-zero on any failed check.
@@ -177,6 +179,22 @@ if kind == "ok":
     print("    " + err.strip().replace("\n", "\n    "))
     check(code == 0, "verne verify of %d recorded rows against the program: clean (tip and axis "
           "tolerance %s)" % (len(sel), tol))
+    # 5. every sample, as halsampler wrote it, read by verne itself: `verify --recording` pairs
+    #    each sample with the nearest point of the program (its contour error), t = tag x 1 ms
+    with open(run_dir + "/recording.txt", "w") as f:
+        for tag, j, line, nfail in rows:
+            f.write("%d %s %d %d\n" % (tag, " ".join("%.6f" % v for v in j), line, nfail))
+    corners = [moves[0][0]] + [b for _, b, _ in moves]
+    with open(run_dir + "/program_path.csv", "w") as f:
+        f.write("x,y,z,phi1,phi2\n" + "".join("%r,%r,%r,%r,%r\n" % p for p in corners))
+    code, out, err = verne(["verify", "--joints", run_dir + "/recording.txt", "--recording",
+                            "--period", "1ms", "--columns", "tag,rho1,rho2,rho3,theta1,theta2,_,_",
+                            "--path", run_dir + "/program_path.csv",
+                            "--threshold", "tip_error_mm=" + tol,
+                            "--threshold", "axis_error_deg=" + tol], "")
+    print("    " + err.strip().replace("\n", "\n    "))
+    check(code == 0, "verne verify --recording of all %d samples against the program's %d points: "
+          "clean (contour tolerance %s)" % (len(rows), len(corners), tol))
 else:
     texts = " | ".join(m["text"] for m in res["errors"])
     check(re.search(r"fails kinematicsInverse", texts) is not None,

@@ -453,6 +453,19 @@ pub struct VerifyArgs {
     /// and defaults are listed below.
     #[arg(long, value_name = "NAME=VALUE", value_parser = crate::arg_values::parse_threshold)]
     pub threshold: Vec<(String, f64)>,
+    /// The joints are a recording of the controller's servo samples (LinuxCNC's halsampler, or
+    /// a halstreamer stream): whitespace-separated numbers, no header, one line per --period.
+    /// Each sample is checked against the nearest point of the path (the contour error), not
+    /// paired with a row; speeds and accelerations from the samples' times.
+    #[arg(long, requires = "period")]
+    pub recording: bool,
+    /// The recording's columns, in order: rho1 rho2 rho3 theta1 theta2 (mm, degrees), `tag`
+    /// (halsampler -t's sample number) and `_` (unused). Default: rho1,rho2,rho3,theta1,theta2.
+    #[arg(long, value_name = "LIST", requires = "recording")]
+    pub columns: Option<String>,
+    /// The servo period of a recording (1ms, 250us, 0.001s): sample k is at k x period.
+    #[arg(long, value_name = "PERIOD", requires = "recording", value_parser = crate::input::resample::parse_period)]
+    pub period: Option<f64>,
 }
 
 #[cfg(test)]

@@ -2,11 +2,13 @@
 //! Opens the files, writes the report CSV atomically, prints the summary, picks the exit code.
 
 use crate::error::VerneError;
+use crate::input::recording::{DEFAULT_COLUMNS, RecordingReader, parse_columns};
 use crate::input::verify_files::{JointInput, PathReader};
 use crate::report::verify::{short_number, summary_json, summary_text};
 use crate::table::Sink;
 use csv::ByteRecord;
-use verne::verify::{Thresholds, VerifyOptions, verify};
+use verne::verify::contour::{ContourPath, verify_recording};
+use verne::verify::{RowSource, Thresholds, VerifyOptions, verify};
 
 use super::{EXIT_OK, EXIT_ROWS_FAILED, load_machine, write_stdout};
 use crate::cli::{VerifyArgs, VerifyFormat};
@@ -38,8 +40,22 @@ pub fn run(args: &VerifyArgs) -> Result<u8, VerneError> {
         tool_length: args.tool_length.unwrap_or(machine.tool_length),
     };
     let options = args.part.read_options(&machine.gcode);
-    let mut joints = JointInput::open(&args.joints, &options)?;
     let mut path = PathReader::open(&args.path, &options, args.part.offset())?;
+    let mut recording = match (args.recording, args.period) {
+        (true, Some(period)) => {
+            let columns = parse_columns(args.columns.as_deref().unwrap_or(DEFAULT_COLUMNS))
+                .map_err(|e| VerneError::Usage(format!("--columns: {e}")))?;
+            Some((
+                RecordingReader::open(&args.joints, columns, period)?,
+                contour_path(&mut path)?,
+            ))
+        }
+        _ => None,
+    };
+    let mut joints = match recording {
+        Some(_) => None,
+        None => Some(JointInput::open(&args.joints, &options)?),
+    };
     let mut sink = match &args.report {
         Some(p) => {
             let mut s = Sink::create(Some(p))?;
@@ -63,7 +79,14 @@ pub fn run(args: &VerifyArgs) -> Result<u8, VerneError> {
         }
         Ok(())
     };
-    let summary = verify(&machine, &opt, &mut joints, &mut path, &mut write);
+    let summary = match (&mut joints, recording.take()) {
+        (Some(j), _) => verify(&machine, &opt, j, &mut path, &mut write),
+        (None, Some((mut r, contour))) => {
+            let name = args.path.display().to_string();
+            verify_recording(&machine, &opt, &mut r, contour, &name, &mut write)
+        }
+        (None, None) => unreachable!("one joint input is open"),
+    };
     let summary = match summary {
         Ok(s) => s,
         Err(e) => {
@@ -82,7 +105,7 @@ pub fn run(args: &VerifyArgs) -> Result<u8, VerneError> {
     if let Some((name, s)) = path.gcode_summary() {
         crate::input::gcode::report_summary("verify", name, &s);
     }
-    if let Some((name, s)) = joints.gcode_summary() {
+    if let Some((name, s)) = joints.as_ref().and_then(|j| j.gcode_summary()) {
         crate::input::gcode::report_summary("verify", name, s);
     }
     let text = format!(
@@ -108,4 +131,32 @@ pub fn run(args: &VerifyArgs) -> Result<u8, VerneError> {
     } else {
         EXIT_ROWS_FAILED
     })
+}
+
+/// The whole intended path, for the nearest-point pairing of a recording: a path row that
+/// cannot be used is fatal here (there is no joint row to report it with).
+fn contour_path(path: &mut PathReader) -> Result<ContourPath, VerneError> {
+    let mut points = Vec::new();
+    while let Some(item) = path.next_item()? {
+        match item.value {
+            Ok(p) => points.push(p),
+            Err(e) => {
+                return Err(VerneError::input(
+                    path.name(),
+                    Some(item.line),
+                    None,
+                    format!("{e}: a recording is compared with every point of the path"),
+                ));
+            }
+        }
+    }
+    if points.is_empty() {
+        return Err(VerneError::input(
+            path.name(),
+            None,
+            None,
+            "no path points: a recording needs the path it follows",
+        ));
+    }
+    Ok(ContourPath::new(points))
 }

@@ -90,6 +90,8 @@ pub struct TcpPose {
     pub row: Row,
     pub tip: [f64; 3],
     pub axis: [f64; 3],
+    /// The angle words (phi1, phi2) in rad, for a program that gives the orientation by them.
+    pub angles: Option<(f64, f64)>,
 }
 
 /// The poses of a tool-centre program.
@@ -159,9 +161,11 @@ impl TcpRows {
             ));
         }
         let tip = [row.get(Axis::X), row.get(Axis::Y), row.get(Axis::Z)];
+        let mut angles = None;
         let axis = match self.orientation {
             GcodeOrientation::Angles { phi1, phi2 } => {
                 let (p1, p2) = (row.get(axis_of(phi1)), row.get(axis_of(phi2)));
+                angles = Some((p1.to_radians(), p2.to_radians()));
                 let v = tool_axis(p1.to_radians(), p2.to_radians());
                 [v.x, v.y, v.z]
             }
@@ -179,7 +183,12 @@ impl TcpRows {
                 self.words()
             ));
         }
-        Some(Ok(TcpPose { row, tip, axis }))
+        Some(Ok(TcpPose {
+            row,
+            tip,
+            axis,
+            angles,
+        }))
     }
 }
 
@@ -292,6 +301,7 @@ impl RowSource for TcpPath {
                 rapid: p.row.motion == Motion::Rapid,
                 feed: p.row.feed_per_min.map(|f| f / 60.0),
                 duration: p.row.duration_s,
+                angles: p.angles,
             })
             .map_err(|e| e.to_string());
         Ok(Some(Item {

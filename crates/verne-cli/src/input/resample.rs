@@ -3,15 +3,16 @@
 //! Each move takes the time its feed gives (the tool tip's path at the feed, or, when the tip
 //! stays, the axis's turn in degrees at the feed, as the G-code post times it; a G-code
 //! program's own time of the move where it states one, `G93`; rapids at `--rapid`); the tool
-//! pose is sampled at every multiple of the period, the tip on the straight line and the axis
-//! turning at a constant rate in the plane of its two ends (slerp), and each sample is then
-//! solved by the inverse kinematics like any row.
+//! pose is sampled at every multiple of the period, the tip on the straight line and the tool
+//! angles (phi1, phi2) interpolated linearly as the controller does
+//! (`verne::machine::orientation::move_angles`: as the input states them, or from the axes), and
+//! each sample is then solved by the inverse kinematics like any row.
 
 use std::io::{self, Write};
 
 use csv::ByteRecord;
 use nalgebra::Vector3;
-use verne::machine::orientation::tool_axis;
+use verne::machine::orientation::{move_angles, tool_axis};
 
 use crate::error::VerneError;
 use crate::input::as_csv::{CsvRows, invalid_data};
@@ -31,6 +32,8 @@ enum Orientation {
 struct Pose {
     tip: Vector3<f64>,
     axis: Vector3<f64>,
+    /// The tool angles (rad) when the input states them (phi1,phi2 columns).
+    angles: Option<(f64, f64)>,
 }
 
 /// The move being sampled: from `a` at `t0` to `b` at `t1` (s).
@@ -136,6 +139,7 @@ impl Resampler {
             self.number(self.xyz[1], "y", &line)?,
             self.number(self.xyz[2], "z", &line)?,
         );
+        let mut angles = None;
         let axis = match self.orientation {
             Orientation::Axis(c) => {
                 let v = Vector3::new(
@@ -151,13 +155,15 @@ impl Resampler {
             }
             Orientation::Angles(c, radians) => {
                 let to_rad = |v: f64| if radians { v } else { v.to_radians() };
-                tool_axis(
+                let (p1, p2) = (
                     to_rad(self.number(c[0], "phi1", &line)?),
                     to_rad(self.number(c[1], "phi2", &line)?),
-                )
+                );
+                angles = Some((p1, p2));
+                tool_axis(p1, p2)
             }
         };
-        Ok(Some((Pose { tip, axis }, line)))
+        Ok(Some((Pose { tip, axis, angles }, line)))
     }
 
     /// The time of the move from `a` to the current record's pose `b` (s).
@@ -201,20 +207,19 @@ impl Resampler {
     }
 }
 
-/// The pose a fraction `s` of the way from `a` to `b`: the tip on the line, the axis by slerp.
+/// The pose a fraction `s` of the way from `a` to `b`: the tip on the line, the tool angles
+/// interpolated as the controller does (`orientation::move_angles`: as stated, or from the
+/// axes), so that the stream follows the same path as the program run by LinuxCNC and as
+/// `verne verify --recording` measures it.
 fn between(a: &Pose, b: &Pose, s: f64) -> Pose {
     let tip = a.tip + (b.tip - a.tip) * s;
-    let angle = a.axis.angle(&b.axis);
-    let axis = if angle < 1e-12 {
-        b.axis
-    } else if (std::f64::consts::PI - angle) < 1e-9 {
-        // Opposite axes: no plane to turn in; jump at the end (the IK rows will say so).
-        if s < 1.0 { a.axis } else { b.axis }
-    } else {
-        let w = angle.sin();
-        (a.axis * (((1.0 - s) * angle).sin() / w) + b.axis * ((s * angle).sin() / w)).normalize()
-    };
-    Pose { tip, axis }
+    let [ea, eb] = move_angles(&a.axis, a.angles, &b.axis, b.angles);
+    let angles = (ea.0 + s * (eb.0 - ea.0), ea.1 + s * (eb.1 - ea.1));
+    Pose {
+        tip,
+        axis: tool_axis(angles.0, angles.1),
+        angles: Some(angles),
+    }
 }
 
 impl CsvRows for Resampler {
@@ -312,6 +317,7 @@ pub fn parse_period(s: &str) -> Result<f64, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::FRAC_PI_2;
 
     #[test]
     fn periods() {
@@ -325,21 +331,39 @@ mod tests {
     }
 
     #[test]
-    fn slerp_keeps_unit_axes_and_turns_evenly() {
+    fn the_axis_follows_the_controllers_angles() {
+        // A tilt in one plane (phi2 fixed): phi1 grows evenly, the axis stays unit.
         let a = Pose {
             tip: Vector3::zeros(),
             axis: Vector3::z(),
+            angles: None,
         };
         let b = Pose {
             tip: Vector3::new(10.0, 0.0, 0.0),
-            axis: Vector3::x(),
+            axis: tool_axis(FRAC_PI_2 / 2.0, 0.0),
+            angles: None,
         };
         for k in 0..=10 {
             let s = k as f64 / 10.0;
             let p = between(&a, &b, s);
             assert!((p.axis.norm() - 1.0).abs() < 1e-12);
-            assert!((p.axis.angle(&a.axis) - s * std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+            assert!((p.axis.angle(&a.axis) - s * FRAC_PI_2 / 2.0).abs() < 1e-12);
             assert!((p.tip.x - 10.0 * s).abs() < 1e-12);
         }
+        // Stated angles are interpolated as stated: A10 C30 -> A0 C0 turns C as it tilts back
+        // (the axis alone would keep C at 30 all the way).
+        let a = Pose {
+            tip: Vector3::zeros(),
+            axis: tool_axis(10f64.to_radians(), 30f64.to_radians()),
+            angles: Some((10f64.to_radians(), 30f64.to_radians())),
+        };
+        let b = Pose {
+            tip: Vector3::zeros(),
+            axis: Vector3::z(),
+            angles: Some((0.0, 0.0)),
+        };
+        let p = between(&a, &b, 0.5);
+        let want = tool_axis(5f64.to_radians(), 15f64.to_radians());
+        assert!((p.axis - want).norm() < 1e-12);
     }
 }

@@ -286,6 +286,7 @@ impl RowSource for PathReader {
                         rapid: row.motion == verne_cl::Motion::Rapid,
                         feed: row.feed_mm_min.map(|f| f / 60.0),
                         duration: None,
+                        angles: None,
                     })
                     .map_err(|e| format!("{} at line {}: {e}", row.kind, row.line));
                 Ok(Some(Item {
@@ -337,10 +338,13 @@ impl RowSource for PathReader {
                 let tip = Vector3::new(v[0], v[1], v[2]) + self.offset;
                 let value = match bad {
                     Some(e) => Err(e),
-                    None if *angles => Ok(PathPoint::new(
-                        tip,
-                        tool_axis(v[3].to_radians(), v[4].to_radians()),
-                    )),
+                    None if *angles => {
+                        let (p1, p2) = (v[3].to_radians(), v[4].to_radians());
+                        Ok(PathPoint {
+                            angles: Some((p1, p2)),
+                            ..PathPoint::new(tip, tool_axis(p1, p2))
+                        })
+                    }
                     None => unit_axis(&Vector3::new(v[3], v[4], v[5]))
                         .map(|axis| PathPoint::new(tip, axis))
                         .map_err(|e| e.to_string()),

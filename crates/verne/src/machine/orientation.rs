@@ -137,6 +137,45 @@ pub fn axis_angles(axis: &Vector3<f64>) -> Result<AxisAngles, AxisError> {
     ]))
 }
 
+/// The tool angles at the two ends of a move as a controller whose world axes are the tool
+/// angles moves them (LinuxCNC with `vernekins`: A = phi1, C = phi2, each interpolated
+/// linearly): the angles the path states at both ends when it states them (a program's words,
+/// a CSV's phi1,phi2), used as stated; otherwise, of the two solutions of each axis, the pair
+/// with the smaller table move |d phi1| + |d phi2| (phi2 the shorter way round), so that a tilt
+/// that changes sign passes through the table normal; an end on the table normal takes the other
+/// end's phi2. The axis along the move is then [`tool_axis`] of the interpolated angles.
+pub fn move_angles(
+    a: &Vector3<f64>,
+    a_stated: Option<(f64, f64)>,
+    b: &Vector3<f64>,
+    b_stated: Option<(f64, f64)>,
+) -> [(f64, f64); 2] {
+    if let (Some(sa), Some(sb)) = (a_stated, b_stated) {
+        return [sa, sb];
+    }
+    // Orientation solution 1 of each end; None for phi2 on the table normal.
+    let angles = |v: &Vector3<f64>| match axis_angles(v) {
+        Ok(AxisAngles::Regular([s, _])) => (s.phi1, Some(s.phi2)),
+        Ok(AxisAngles::NearRotary { phi1_abs }) => (phi1_abs, None),
+        Err(_) => (0.0, None),
+    };
+    let ((p1a, p2a), (p1b, p2b)) = (angles(a), angles(b));
+    let p2a = p2a.or(p2b).unwrap_or(0.0);
+    let p2b = p2b.unwrap_or(p2a);
+    let both = |p1: f64, p2: f64| [(p1, p2), (-p1, wrap_angle(p2 + PI))];
+    let mut best: Option<(f64, [(f64, f64); 2])> = None;
+    for ea in both(p1a, p2a) {
+        for eb in both(p1b, p2b) {
+            let d2 = wrap_angle(eb.1 - ea.1);
+            let cost = (eb.0 - ea.0).abs() + d2.abs();
+            if best.is_none_or(|(c, _)| cost < c - 1e-12) {
+                best = Some((cost, [ea, (eb.0, ea.1 + d2)]));
+            }
+        }
+    }
+    best.expect("four candidates").1
+}
+
 /// The phi1 whose axis, at the given phi2, is nearest the (unit) axis `a`: the signed tilt in the
 /// plane of azimuth phi2. Exact when phi2 is one of the axis's own solutions; used inside the
 /// rotary-singularity cone, where the achieved axis then differs from `a` by at most the cone.

@@ -17,6 +17,7 @@
 //! and reported in input order, so memory does not grow with the files and results do not depend
 //! on the number of threads. Only the previous row and segment are kept between batches.
 
+pub mod contour;
 mod findings;
 mod row;
 mod segment;
@@ -163,6 +164,10 @@ pub struct PathPoint {
     /// The time of the move to this point (s), when the path states it (a G-code program: the
     /// controller's feed rule, or inverse time): preferred to `feed`.
     pub duration: Option<f64>,
+    /// The tool angles (phi1, phi2) (rad) as the path states them (a CSV with phi1,phi2, a
+    /// program's angle words), not only the axis: a controller interpolates these, and near the
+    /// table normal they say which way it turns ([`contour`]).
+    pub angles: Option<(f64, f64)>,
 }
 
 impl PathPoint {
@@ -174,6 +179,7 @@ impl PathPoint {
             rapid: false,
             feed: None,
             duration: None,
+            angles: None,
         }
     }
 }

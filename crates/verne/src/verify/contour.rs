@@ -1,0 +1,478 @@
+//! Recorded joints against the intended path: a controller's servo samples (a `halsampler`
+//! recording, a halstreamer stream) have no row of the path to be paired with, so each sample is
+//! paired with the nearest point of the path instead, and the row checks measure the contour
+//! error (how far the tool is from the programmed path), not the tracking error (how late it is
+//! there). Everything else (limits, singularity, branch, jumps, speeds from the samples' times)
+//! is checked as for a joint table.
+//!
+//! The path between two points is the straight line of the tip and the linear interpolation of
+//! the tool angles (phi1, phi2) (AIM 2007 eq. (8)), as a controller whose world coordinates are
+//! X Y Z and the two tool angles interpolates it (LinuxCNC with `vernekins`), the angles of each
+//! move by [`move_angles`] (as stated by the path, or from the axes), the same interpolation as
+//! `verne ik --period` streams. Nearest is measured
+//! in X Y Z (mm) and the angle between the axes weighted by [`ANGLE_WEIGHT_MM_PER_RAD`] (1 mm
+//! per degree, the controller's own units): the segment by a projection in the angles (phi2
+//! counted with sin(phi1), its arc on the sphere of axes), the point on it by a golden-section
+//! search on that distance.
+
+use std::cell::RefCell;
+use std::f64::consts::PI;
+use std::rc::Rc;
+
+use nalgebra::{SVector, Vector3};
+
+use super::{
+    Item, JointSource, Joints, PairingError, PathPoint, RowSource, Summary, VerifyOptions,
+    Violation, machine_kind, verify,
+};
+use crate::machine::machine_fk;
+use crate::machine::orientation::{move_angles, tool_axis};
+use crate::parallel_module::ik::wrap_angle;
+use crate::spec::Machine;
+
+/// Weight of the tool angles against the tip when finding the nearest point (mm per rad): one
+/// millimetre per degree.
+pub const ANGLE_WEIGHT_MM_PER_RAD: f64 = 180.0 / PI;
+
+/// Segments searched on each side of the previous sample's segment before the whole path is
+/// searched (samples move along the path, a few per segment or many).
+pub const SEARCH_WINDOW: usize = 64;
+
+/// A sample farther than this (weighted mm) from the path inside the window is looked for on the
+/// whole path (the window may have lost it: a sample that jumped, the path's start).
+pub const WINDOW_TRUST_MM: f64 = 1.0;
+
+/// Golden-section steps refining the parameter on the nearest segment (0.618^60 ~ 3e-13).
+const GOLDEN_STEPS: usize = 60;
+
+/// The two ends of a segment in tool angles, as the controller interpolates them.
+#[derive(Debug, Clone, Copy)]
+struct SegmentAngles {
+    a: (f64, f64),
+    b: (f64, f64),
+    /// |sin(phi1)| at the middle: the weight of a phi2 difference.
+    s: f64,
+}
+
+impl SegmentAngles {
+    fn at(&self, u: f64) -> (f64, f64) {
+        (
+            self.a.0 + u * (self.b.0 - self.a.0),
+            self.a.1 + u * (self.b.1 - self.a.1),
+        )
+    }
+}
+
+/// The intended path, held whole, for the nearest-point search.
+#[derive(Debug, Clone)]
+pub struct ContourPath {
+    nodes: Vec<PathPoint>,
+    /// The angles of each segment ([`move_angles`]), one per segment (one for a single point).
+    segments: Vec<SegmentAngles>,
+    /// The segment of the previous sample (the search starts there).
+    cursor: usize,
+}
+
+/// The nearest point of the path to a sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Nearest {
+    /// The intended pose there (tip and axis interpolated).
+    pub point: PathPoint,
+    /// The segment (0-based: from point k to point k + 1) and the parameter along it, in [0, 1].
+    pub segment: usize,
+    pub u: f64,
+    /// The weighted distance (mm).
+    pub distance: f64,
+}
+
+/// The two tool-angle solutions of one axis direction (AIM 2007 eq. (8)).
+fn both(phi1: f64, phi2: f64) -> [(f64, f64); 2] {
+    [(phi1, phi2), (-phi1, wrap_angle(phi2 + PI))]
+}
+
+impl ContourPath {
+    /// The path's points in order.
+    pub fn new(points: Vec<PathPoint>) -> ContourPath {
+        let segments = (0..points.len().saturating_sub(1).max(points.len().min(1)))
+            .map(|k| {
+                let (a, b) = (&points[k], &points[(k + 1).min(points.len() - 1)]);
+                let [ea, eb] = move_angles(&a.axis, a.angles, &b.axis, b.angles);
+                SegmentAngles {
+                    a: ea,
+                    b: eb,
+                    s: (0.5 * (ea.0 + eb.0)).sin().abs(),
+                }
+            })
+            .collect();
+        ContourPath {
+            nodes: points,
+            segments,
+            cursor: 0,
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.nodes.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.nodes.is_empty()
+    }
+
+    /// The nearest point of the path to a tool pose (tip, and angles as the machine's forward
+    /// kinematics gives them, either orientation solution); None for an empty path.
+    pub fn nearest(&mut self, tip: &Vector3<f64>, phi1: f64, phi2: f64) -> Option<Nearest> {
+        let n = self.nodes.len();
+        if n == 0 {
+            return None;
+        }
+        let segments = (n - 1).max(1);
+        let lo = self.cursor.saturating_sub(SEARCH_WINDOW);
+        let hi = (self.cursor + SEARCH_WINDOW + 1).min(segments);
+        let mut best = self.best_in(lo..hi, tip, phi1, phi2);
+        if best.distance > WINDOW_TRUST_MM && (lo > 0 || hi < segments) {
+            let whole = self.best_in(0..segments, tip, phi1, phi2);
+            if whole.distance < best.distance {
+                best = whole;
+            }
+        }
+        self.cursor = best.segment;
+        Some(best)
+    }
+
+    fn best_in(
+        &self,
+        range: std::ops::Range<usize>,
+        tip: &Vector3<f64>,
+        phi1: f64,
+        phi2: f64,
+    ) -> Nearest {
+        let mut best: Option<(usize, f64, f64, SegmentAngles)> = None;
+        for k in range {
+            let seg = self.segments[k];
+            for sample in both(phi1, phi2) {
+                let (u, d) = self.project(k, &seg, tip, sample);
+                if best.is_none_or(|b| d < b.2) {
+                    best = Some((k, u, d, seg));
+                }
+            }
+        }
+        let (segment, u0, _, seg) = best.expect("a non-empty range");
+        // The projection weighs phi2 by the segment's mean tilt; the distance that counts
+        // compares the axes themselves (none of phi2 at the table normal): refine on it.
+        let axis = tool_axis(phi1, phi2);
+        let d = |u: f64| self.pose_distance(segment, &seg, u, tip, &axis);
+        let (mut u, mut distance) = (u0, d(u0));
+        let (mut lo, mut hi) = (0.0f64, 1.0f64);
+        let g = 0.5 * (5f64.sqrt() - 1.0);
+        let (mut x1, mut x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
+        let (mut f1, mut f2) = (d(x1), d(x2));
+        for _ in 0..GOLDEN_STEPS {
+            if f1 <= f2 {
+                hi = x2;
+                (x2, f2) = (x1, f1);
+                x1 = hi - g * (hi - lo);
+                f1 = d(x1);
+            } else {
+                lo = x1;
+                (x1, f1) = (x2, f2);
+                x2 = lo + g * (hi - lo);
+                f2 = d(x2);
+            }
+        }
+        for (x, f) in [(x1, f1), (x2, f2), (0.0, d(0.0)), (1.0, d(1.0))] {
+            if f < distance {
+                (u, distance) = (x, f);
+            }
+        }
+        Nearest {
+            point: self.at(segment, &seg, u),
+            segment,
+            u,
+            distance,
+        }
+    }
+
+    /// The distance that counts: the tips (mm) and the angle between the axes, weighted.
+    fn pose_distance(
+        &self,
+        k: usize,
+        seg: &SegmentAngles,
+        u: f64,
+        tip: &Vector3<f64>,
+        axis: &Vector3<f64>,
+    ) -> f64 {
+        let p = self.at(k, seg, u);
+        let angle = axis.cross(&p.axis).norm().atan2(axis.dot(&p.axis));
+        ((tip - p.tip).norm_squared() + (ANGLE_WEIGHT_MM_PER_RAD * angle).powi(2)).sqrt()
+    }
+
+    /// The parameter of the point of segment `k` nearest the sample (the projection in X Y Z
+    /// and the weighted angles, clamped to the segment) and the weighted distance there.
+    fn project(
+        &self,
+        k: usize,
+        seg: &SegmentAngles,
+        tip: &Vector3<f64>,
+        (phi1, phi2): (f64, f64),
+    ) -> (f64, f64) {
+        let w = ANGLE_WEIGHT_MM_PER_RAD;
+        let coords = |x: &Vector3<f64>, p1: f64, p2: f64| {
+            SVector::<f64, 5>::new(x.x, x.y, x.z, w * p1, w * seg.s * p2)
+        };
+        let a = &self.nodes[k];
+        let b = &self.nodes[(k + 1).min(self.nodes.len() - 1)];
+        let pa = coords(&a.tip, seg.a.0, seg.a.1);
+        let pb = coords(&b.tip, seg.b.0, seg.b.1);
+        // The sample's phi2 taken near the segment's.
+        let q = coords(tip, phi1, seg.a.1 + wrap_angle(phi2 - seg.a.1));
+        let d = pb - pa;
+        let dd = d.norm_squared();
+        let u = if dd == 0.0 {
+            0.0
+        } else {
+            ((q - pa).dot(&d) / dd).clamp(0.0, 1.0)
+        };
+        let (p1, p2) = seg.at(u);
+        let t = a.tip + u * (b.tip - a.tip);
+        let da = w * (phi1 - p1);
+        let db = w * p1.sin().abs() * wrap_angle(phi2 - p2);
+        (u, ((tip - t).norm_squared() + da * da + db * db).sqrt())
+    }
+
+    /// The intended pose at parameter `u` of segment `k`: the tip on the straight line, the axis
+    /// of the interpolated angles; the move's rapid flag, feed and time are the end point's.
+    fn at(&self, k: usize, seg: &SegmentAngles, u: f64) -> PathPoint {
+        let a = &self.nodes[k];
+        let b = &self.nodes[(k + 1).min(self.nodes.len() - 1)];
+        let (p1, p2) = seg.at(u);
+        PathPoint {
+            tip: a.tip + u * (b.tip - a.tip),
+            axis: tool_axis(p1, p2),
+            ..*b
+        }
+    }
+}
+
+/// The last joint row read, shared between the joint source and the path it is projected on.
+type LastRow = Rc<RefCell<Option<Result<Joints, String>>>>;
+
+/// The recording, remembering each row for [`Projected`].
+struct Tee<'a, J> {
+    inner: &'a mut J,
+    last: LastRow,
+}
+
+impl<J: JointSource> RowSource for Tee<'_, J> {
+    type Row = Joints;
+    type Error = J::Error;
+
+    fn name(&self) -> &str {
+        self.inner.name()
+    }
+
+    fn has_id(&self) -> bool {
+        false
+    }
+
+    fn next_item(&mut self) -> Result<Option<Item<Joints>>, J::Error> {
+        let item = self.inner.next_item()?;
+        *self.last.borrow_mut() = item.as_ref().map(|i| i.value.clone());
+        Ok(item)
+    }
+}
+
+impl<J: JointSource> JointSource for Tee<'_, J> {
+    fn timed(&self) -> bool {
+        self.inner.timed()
+    }
+}
+
+/// The intended path as a row source: for each joint row just read, its nearest point.
+struct Projected<'a, E> {
+    machine: &'a Machine,
+    tool_length: f64,
+    path: ContourPath,
+    name: String,
+    last: LastRow,
+    index: u64,
+    previous: Option<PathPoint>,
+    _error: std::marker::PhantomData<E>,
+}
+
+impl<E> RowSource for Projected<'_, E> {
+    type Row = PathPoint;
+    type Error = E;
+
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn has_id(&self) -> bool {
+        false
+    }
+
+    fn next_item(&mut self) -> Result<Option<Item<PathPoint>>, E> {
+        let Some(row) = self.last.borrow_mut().take() else {
+            return Ok(None);
+        };
+        self.index += 1;
+        let nearest = row.ok().and_then(|q| {
+            // The tool pose of the machine's assembly mode (the row check picks the same kind).
+            let modes = machine_fk(self.machine, &q.rho, q.theta1, q.theta2, self.tool_length);
+            let mode = modes
+                .iter()
+                .filter(|md| machine_kind(md.config, md.module.alpha, self.machine))
+                .min_by(|a, b| {
+                    let near = |t: &Vector3<f64>| self.previous.map_or(0.0, |p| (t - p.tip).norm());
+                    near(&a.tool.tip).total_cmp(&near(&b.tool.tip))
+                })?;
+            self.path
+                .nearest(&mode.tool.tip, mode.tool.phi1, mode.tool.phi2)
+        });
+        // A row that cannot be solved is reported by the row check; pair it with the last point.
+        let point = match (nearest, self.previous) {
+            (Some(n), _) => n.point,
+            (None, Some(p)) => p,
+            (None, None) => self.path.nodes[0],
+        };
+        self.previous = Some(point);
+        Ok(Some(Item {
+            index: self.index,
+            line: self.index,
+            id: None,
+            value: Ok(point),
+        }))
+    }
+}
+
+/// [`verify`] of a recording: each joint row against the nearest point of `path` (module
+/// documentation). An empty path is an error of the caller (nothing to compare with).
+pub fn verify_recording<J, E>(
+    m: &Machine,
+    opt: &VerifyOptions,
+    joints: &mut J,
+    path: ContourPath,
+    path_name: &str,
+    report: &mut dyn FnMut(&Violation) -> Result<(), E>,
+) -> Result<Summary, E>
+where
+    J: JointSource<Error = E>,
+    E: From<PairingError>,
+{
+    assert!(!path.is_empty(), "verify_recording needs a path");
+    let last: LastRow = Rc::new(RefCell::new(None));
+    let mut tee = Tee {
+        inner: joints,
+        last: last.clone(),
+    };
+    let mut projected = Projected {
+        machine: m,
+        tool_length: opt.tool_length,
+        path,
+        name: path_name.to_string(),
+        last,
+        index: 0,
+        previous: None,
+        _error: std::marker::PhantomData,
+    };
+    verify(m, opt, &mut tee, &mut projected, report)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::machine::orientation::tool_axis;
+
+    fn point(x: f64, y: f64, z: f64, phi1_deg: f64, phi2_deg: f64) -> PathPoint {
+        PathPoint::new(
+            Vector3::new(x, y, z),
+            tool_axis(phi1_deg.to_radians(), phi2_deg.to_radians()),
+        )
+    }
+
+    #[test]
+    fn a_point_on_the_path_is_its_own_nearest() {
+        let mut path = ContourPath::new(vec![
+            point(0.0, 0.0, 100.0, 0.0, 0.0),
+            point(50.0, 0.0, 100.0, 20.0, 0.0),
+            point(50.0, 40.0, 80.0, 20.0, 90.0),
+        ]);
+        // A third of the way along the second segment: tip, phi1 = 20, phi2 = 30 degrees.
+        let tip = Vector3::new(50.0, 40.0 / 3.0, 100.0 - 20.0 / 3.0);
+        let n = path
+            .nearest(&tip, 20f64.to_radians(), 30f64.to_radians())
+            .unwrap();
+        assert_eq!(n.segment, 1);
+        assert!((n.u - 1.0 / 3.0).abs() < 1e-12, "{}", n.u);
+        assert!(n.distance < 1e-9);
+        assert!((n.point.tip - tip).norm() < 1e-12);
+        let axis = tool_axis(20f64.to_radians(), 30f64.to_radians());
+        assert!((n.point.axis - axis).norm() < 1e-12);
+        // The same pose in orientation solution 2 is the same point.
+        let m = path
+            .nearest(&tip, -20f64.to_radians(), (30f64 - 180.0).to_radians())
+            .unwrap();
+        assert!(m.distance < 1e-9 && m.segment == 1);
+    }
+
+    #[test]
+    fn a_tilt_through_the_table_normal_is_interpolated_as_the_controller_does() {
+        // A10 C45 -> A-5 C90 (data/linuxcnc/verne-tcp.ngc): the controller moves A through 0.
+        // The axes alone give (10, 45) and (5, -90); the path through the pole is the pair
+        // with the smaller table move.
+        let mut path = ContourPath::new(vec![
+            point(40.0, 10.0, 80.0, 10.0, 45.0),
+            point(10.0, -20.0, 70.0, -5.0, 90.0),
+        ]);
+        for u in [0.25, 0.5, 2.0 / 3.0, 0.9] {
+            let (p1, p2) = (10.0 + u * (-15.0), 45.0 + u * 45.0);
+            let tip = Vector3::new(40.0 - 30.0 * u, 10.0 - 30.0 * u, 80.0 - 10.0 * u);
+            let n = path
+                .nearest(&tip, f64::to_radians(p1), f64::to_radians(p2))
+                .unwrap();
+            assert!(n.distance < 1e-9, "u {u}: {}", n.distance);
+            assert!((n.u - u).abs() < 1e-9);
+            let axis = tool_axis(p1.to_radians(), p2.to_radians());
+            assert!((n.point.axis - axis).norm() < 1e-12);
+        }
+        // A vertical end takes the other end's phi2: A0 C0 -> A10 C45 tilts in the C45 plane.
+        let mut path = ContourPath::new(vec![
+            point(20.0, 10.0, 80.0, 0.0, 0.0),
+            point(40.0, 10.0, 80.0, 10.0, 45.0),
+        ]);
+        let n = path
+            .nearest(
+                &Vector3::new(30.0, 10.0, 80.0),
+                5f64.to_radians(),
+                45f64.to_radians(),
+            )
+            .unwrap();
+        assert!(n.distance < 1e-9, "{}", n.distance);
+    }
+
+    #[test]
+    fn an_offset_sample_measures_its_distance_and_a_far_one_is_found_outside_the_window() {
+        let points: Vec<PathPoint> = (0..1000)
+            .map(|k| point(k as f64, 0.0, 100.0, 10.0, 0.0))
+            .collect();
+        let mut path = ContourPath::new(points);
+        // 0.3 mm beside the line near its start.
+        let n = path
+            .nearest(&Vector3::new(5.5, 0.3, 100.0), 10f64.to_radians(), 0.0)
+            .unwrap();
+        assert_eq!(n.segment, 5);
+        assert!((n.distance - 0.3).abs() < 1e-12);
+        // A sample near the end: beyond the window from segment 5, found by the whole search.
+        let n = path
+            .nearest(&Vector3::new(900.25, 0.0, 100.0), 10f64.to_radians(), 0.0)
+            .unwrap();
+        assert_eq!(n.segment, 900);
+        assert!(n.distance < 1e-9);
+        // An angle error weighs 1 mm per degree (phi1; phi2 by sin phi1).
+        let n = path
+            .nearest(&Vector3::new(900.25, 0.0, 100.0), 12f64.to_radians(), 0.0)
+            .unwrap();
+        assert!((n.distance - 2.0).abs() < 1e-9, "{}", n.distance);
+    }
+}
