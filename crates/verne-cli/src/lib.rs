@@ -63,17 +63,20 @@ use std::process::ExitCode;
 
 use clap::Parser;
 
-/// Exit code after Ctrl-C or SIGTERM (128 + SIGINT), once temporary output files are removed.
-const EXIT_INTERRUPTED: i32 = 130;
-
 /// Runs the `verne` command on the process's arguments: parses them, runs one subcommand,
 /// prints one error and returns the exit code (0 ok, 1 some row or check failed, 2 fatal).
 pub fn run() -> ExitCode {
-    // An interrupted run leaves neither a partial output file nor a temporary file behind.
-    let _ = ctrlc::set_handler(|| {
-        table::remove_temp_files();
-        std::process::exit(EXIT_INTERRUPTED);
-    });
+    // An interrupted run (SIGINT, SIGTERM, SIGHUP) leaves neither a partial output file nor a
+    // temporary file behind, and exits with 128 + the signal's number, as a shell reports it.
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    if let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) {
+        std::thread::spawn(move || {
+            if let Some(signal) = signals.forever().next() {
+                table::remove_temp_files();
+                std::process::exit(128 + signal);
+            }
+        });
+    }
     let cli = match cli::Cli::try_parse() {
         Ok(c) => c,
         Err(e) => {

@@ -289,8 +289,20 @@ impl Sink {
                         .map_err(|e| VerneError::io(&name, e))?;
                     (Box::new(BufWriter::with_capacity(1 << 16, f)), None, name)
                 } else {
-                    let tmp = temp_path_for(&dest.path);
-                    let f = File::create(&tmp).map_err(|e| VerneError::io(&name, e))?;
+                    remove_stale_temps(&dest.path);
+                    let tmp = temp_path_for(&dest.path, "");
+                    let f = File::create(&tmp).map_err(|e| {
+                        VerneError::io(
+                            &name,
+                            io::Error::new(
+                                e.kind(),
+                                format!(
+                                    "cannot create the temporary file {} beside it (the output is written there, then renamed): {e}",
+                                    tmp.display()
+                                ),
+                            ),
+                        )
+                    })?;
                     (
                         Box::new(BufWriter::with_capacity(1 << 16, f)),
                         Some((tmp, dest.path)),
@@ -509,6 +521,22 @@ pub fn read_input_file(path: &Path) -> io::Result<Vec<u8>> {
 /// (the same file under any name: a hard or symbolic link too) is refused, since the run would
 /// replace what it reads; so is an existing file without any write permission (root could
 /// otherwise replace it).
+/// [`check_output_target`], and the directory the file goes to exists: checked before a
+/// command computes anything, so a bad output path fails at once.
+pub fn check_output_path(path: &Path) -> io::Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    if !dir.is_dir() {
+        return Err(io::Error::new(
+            io::ErrorKind::NotFound,
+            format!("the directory {} does not exist", dir.display()),
+        ));
+    }
+    check_output_target(path)
+}
+
 fn check_output_target(path: &Path) -> io::Result<()> {
     use std::os::unix::fs::{MetadataExt, PermissionsExt};
     let Ok(m) = std::fs::metadata(path) else {
@@ -541,7 +569,8 @@ pub fn write_output(path: &Path, bytes: &[u8]) -> io::Result<()> {
     if dest.in_place {
         return std::fs::write(&dest.path, bytes);
     }
-    let tmp = temp_path_for(&dest.path);
+    remove_stale_temps(&dest.path);
+    let tmp = temp_path_for(&dest.path, "");
     std::fs::write(&tmp, bytes)
         .and_then(|_| keep_attributes(&dest.path, &tmp))
         .and_then(|_| std::fs::rename(&tmp, &dest.path))
@@ -550,16 +579,73 @@ pub fn write_output(path: &Path, bytes: &[u8]) -> io::Result<()> {
         })
 }
 
-/// `dir/.name.verne-PID.tmp` beside the target.
-fn temp_path_for(p: &Path) -> PathBuf {
+/// The longest file name the usual file systems take (bytes).
+const NAME_MAX_BYTES: usize = 255;
+
+/// The temporary file an output is written to before it is renamed into place:
+/// `dir/.NAME.verne-PID.tmpEXT` beside the target (`ext`, e.g. `.png`, keeps the bitmap
+/// encoder's format), or `dir/.verne-PID-HASH.tmpEXT` when that name would pass NAME_MAX. A run
+/// killed by SIGKILL leaves it behind; the next run to the same target removes those of dead
+/// processes ([`remove_stale_temps`]).
+pub fn temp_path_for(p: &Path, ext: &str) -> PathBuf {
     let file = p
         .file_name()
         .map(|f| f.to_string_lossy().into_owned())
         .unwrap_or_else(|| "out".into());
-    let tmp = format!(".{file}.verne-{}.tmp", std::process::id());
+    let pid = std::process::id();
+    let mut tmp = format!(".{file}.verne-{pid}.tmp{ext}");
+    if tmp.len() > NAME_MAX_BYTES {
+        tmp = format!(".verne-{pid}-{:016x}.tmp{ext}", name_hash(&file));
+    }
     match p.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.join(tmp),
         _ => PathBuf::from(tmp),
+    }
+}
+
+/// A stable hash of a file name (FNV-1a), for the shortened temporary name.
+fn name_hash(name: &str) -> u64 {
+    name.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    })
+}
+
+/// Removes the temporary files of the target `p` left by runs that no longer exist (killed by
+/// SIGKILL, which no handler sees): `.NAME.verne-PID.tmp*` (or the shortened form) whose PID is
+/// not a running process. Another live run's file is left alone.
+pub fn remove_stale_temps(p: &Path) {
+    let file = p
+        .file_name()
+        .map(|f| f.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "out".into());
+    let dir = match p.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let long = format!(".{file}.verne-");
+    let short = format!("-{:016x}.tmp", name_hash(&file));
+    let Ok(entries) = std::fs::read_dir(&dir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        let pid = if let Some(rest) = name.strip_prefix(&long) {
+            rest.split(".tmp")
+                .next()
+                .and_then(|p| p.parse::<u32>().ok())
+        } else if let Some(rest) = name.strip_prefix(".verne-")
+            && rest.contains(&short)
+        {
+            rest.split('-').next().and_then(|p| p.parse::<u32>().ok())
+        } else {
+            None
+        };
+        if let Some(pid) = pid
+            && pid != std::process::id()
+            && !Path::new(&format!("/proc/{pid}")).exists()
+        {
+            let _ = std::fs::remove_file(e.path());
+        }
     }
 }
 

@@ -391,3 +391,90 @@ fn round2_item9_negative_step_comment_after_section_and_semicolon_machine_files(
         stderr(&c)
     );
 }
+
+/// Item 9, the rest: control bytes are escaped in messages; a picture path is checked before
+/// anything is computed and named once; a long output name still gets a temporary file; stale
+/// temporary files of dead runs are removed, a live run's kept; a machine in metres is refused
+/// for its rod lengths.
+#[test]
+fn round2_item9_escapes_early_checks_temp_names_and_tiny_machines() {
+    // ESC and NUL from the input are shown escaped, never raw.
+    let out = run(&["ik"], Some("xp,yp,zp\n1,2,\x1b[31mX\x00\n"));
+    assert_eq!(out.status.code(), Some(2));
+    let err = stderr(&out);
+    assert!(!err.contains('\x1b') && !err.contains('\0'), "{err:?}");
+    assert!(err.contains("\\u{1b}[31mX\\u{0}"), "{err}");
+
+    // A picture into a directory that does not exist: refused before the workspace is sampled,
+    // the path named once.
+    let out = run(
+        &[
+            "workspace",
+            "--step",
+            "5",
+            "--plot",
+            "/nonexistent-dir/w.svg",
+        ],
+        None,
+    );
+    assert_eq!(out.status.code(), Some(2));
+    let err = stderr(&out);
+    assert_eq!(err.matches("/nonexistent-dir/w.svg").count(), 1, "{err}");
+    assert!(
+        err.contains("does not exist") && !err.contains("points/s"),
+        "{err}"
+    );
+    let out = run(
+        &[
+            "modes",
+            "--joints",
+            "674,685,250",
+            "--plot",
+            "/nonexistent-dir/m.png",
+        ],
+        None,
+    );
+    assert_eq!(out.status.code(), Some(2));
+    assert!(out.stdout.is_empty(), "nothing computed");
+
+    // A 250-byte output name: the temporary name would pass NAME_MAX, a shorter one is used.
+    let dir = scratch("item9-rest");
+    std::fs::create_dir_all(&dir).unwrap();
+    let long = dir.join(format!("{}.csv", "n".repeat(246)));
+    let out = run(
+        &["ik", "-q", "-o", long.to_str().unwrap()],
+        Some("xp,yp,zp\n0,0,1100\n"),
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    assert!(std::fs::read_to_string(&long).unwrap().contains("ok"));
+
+    // A temporary file left by a killed run (a PID that is not running) is removed by the next
+    // run to the same target; one of a live process (PID 1) is not.
+    let target = dir.join("out.csv");
+    let dead = dir.join(".out.csv.verne-4000000.tmp");
+    let live = dir.join(".out.csv.verne-1.tmp");
+    std::fs::write(&dead, "partial").unwrap();
+    std::fs::write(&live, "in progress").unwrap();
+    let out = run(
+        &["ik", "-q", "-o", target.to_str().unwrap()],
+        Some("xp,yp,zp\n0,0,1100\n"),
+    );
+    assert_eq!(out.status.code(), Some(0));
+    assert!(!dead.exists() && live.exists() && target.exists());
+
+    // A machine written in metres: refused for its rods, with the reason.
+    let metres = dir.join("metres.toml");
+    std::fs::write(
+        &metres,
+        "base = \"verne\"\n[module]\nL1 = 0.9\nL2 = 0.85\nL3 = 0.85\n",
+    )
+    .unwrap();
+    let out = run(&["machine", "check", metres.to_str().unwrap()], None);
+    assert_eq!(out.status.code(), Some(2));
+    let err = stderr(&out);
+    assert!(
+        err.contains("module.L1") && err.contains("in mm (a file in metres?)"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

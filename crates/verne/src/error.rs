@@ -57,7 +57,17 @@ pub const MESSAGE_CHARS: usize = 120;
 /// Input bytes as they may be quoted in a message: invalid UTF-8 escaped, long text shortened.
 pub fn shown(bytes: &[u8]) -> String {
     let text = match std::str::from_utf8(bytes) {
-        Ok(t) => t.to_string(),
+        // Control characters (NUL, ESC, ...) escaped: input is never echoed raw to a terminal.
+        Ok(t) => t
+            .chars()
+            .map(|c| {
+                if c.is_control() {
+                    c.escape_default().to_string()
+                } else {
+                    c.to_string()
+                }
+            })
+            .collect(),
         Err(_) => bytes.escape_ascii().to_string(),
     };
     if text.chars().count() > MESSAGE_CHARS {

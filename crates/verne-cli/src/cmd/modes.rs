@@ -42,6 +42,9 @@ const FIGURES: [&str; 7] = [
 ];
 
 pub fn run(args: &ModesArgs) -> Result<u8, VerneError> {
+    if let Some(p) = &args.plot {
+        crate::plot::check_picture_path(p)?;
+    }
     let machine = match load_mechanism(args.common.machine.as_deref())? {
         Mechanism::Glider(spec) => {
             refuse_for_glider(

@@ -264,7 +264,7 @@ pub fn run(args: &WorkspaceArgs) -> Result<u8, VerneError> {
         )));
     }
     if let Some(p) = &args.plot {
-        plot::Format::of_path(p).map_err(VerneError::Usage)?;
+        plot::check_picture_path(p)?;
     }
     let bounds = args.bounds.map(|b| Bounds {
         min: Vector3::new(b[0], b[2], b[4]),

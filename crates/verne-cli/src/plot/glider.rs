@@ -11,10 +11,7 @@ use plotters::prelude::*;
 use plotters::series::DashedLineSeries;
 use verne::glider::{GliderSpec, NodeClass, Rectangle as Region, WorkspaceGrid};
 
-use super::{
-    FAMILY, Format, draw_title_and_legend, drawing, io_err, register_font,
-    temp_path_keeping_extension,
-};
+use super::{FAMILY, Format, draw_title_and_legend, drawing, io_err, register_font};
 use std::path::Path;
 
 /// Width of the workspace chart's plotting area (px).

@@ -7,7 +7,7 @@
 //! drawn with DejaVu Sans, embedded from `assets/fonts/` (Bitstream Vera licence, which allows
 //! redistribution with software; see `assets/fonts/LICENSE-DejaVu.txt`).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Once;
 
 use plotters::coord::Shift;
@@ -68,26 +68,18 @@ pub fn outcome_color(o: Outcome) -> RGBColor {
     }
 }
 
-/// `dir/.name.verne-PID.tmp.ext` beside `path`: the bitmap encoder picks its format from the
-/// extension.
-fn temp_path_keeping_extension(path: &Path) -> PathBuf {
-    let name = path
-        .file_name()
-        .map(|f| f.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "picture".into());
-    let ext = path
-        .extension()
-        .map(|e| format!(".{}", e.to_string_lossy()))
-        .unwrap_or_default();
-    let tmp = format!(".{name}.verne-{}.tmp{ext}", std::process::id());
-    match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.join(tmp),
-        _ => PathBuf::from(tmp),
-    }
+/// A drawing's I/O error, for a caller that names the file ([`check_picture_path`]'s callers).
+fn io_err(_path: &Path, e: impl std::fmt::Display) -> String {
+    e.to_string()
 }
 
-fn io_err(path: &Path, e: impl std::fmt::Display) -> String {
-    format!("{}: {e}", path.display())
+/// Checks a picture's path before anything is computed: a known extension, a directory that
+/// exists, not a read-only file (the same check as every output).
+pub fn check_picture_path(path: &Path) -> Result<(), crate::error::VerneError> {
+    use crate::error::VerneError;
+    Format::of_path(path).map_err(VerneError::Usage)?;
+    crate::table::check_output_path(path)
+        .map_err(|e| VerneError::io(&path.display().to_string(), e))
 }
 
 /// Draws with `$draw(&root)` on an SVG or PNG backend of `$size` and writes `$path` atomically.
@@ -97,7 +89,9 @@ macro_rules! render {
         register_font();
         // A device or a FIFO is written in place (see `table::output_destination`).
         let dest = crate::table::output_destination(path);
-        match Format::of_path(path)? {
+        match Format::of_path(path)
+            .map_err(|_| String::from("a picture file must end in .svg or .png"))?
+        {
             Format::Svg => {
                 let mut text = String::new();
                 {
@@ -112,7 +106,13 @@ macro_rules! render {
                 let tmp = if dest.in_place {
                     dest.path.clone()
                 } else {
-                    temp_path_keeping_extension(&dest.path)
+                    crate::table::remove_stale_temps(&dest.path);
+                    let ext = dest
+                        .path
+                        .extension()
+                        .map(|e| format!(".{}", e.to_string_lossy()))
+                        .unwrap_or_default();
+                    crate::table::temp_path_for(&dest.path, &ext)
                 };
                 let drawn = (|| -> Result<(), String> {
                     let root = BitMapBackend::new(&tmp, $size).into_drawing_area();

@@ -15,6 +15,11 @@ use crate::error::{MachineError, Problem};
 /// double; a kilometre is 1e6 mm.
 pub const MAX_LENGTH_MM: f64 = 1e30;
 
+/// The shortest rod (mm) a machine file may give: the solvers' tolerances are absolute, in mm
+/// (tolerance.rs: residuals accepted below 1e-6 mm), so a machine much smaller than a millimetre
+/// (or one written in metres) would be solved to nothing it can resolve.
+pub const MIN_ROD_MM: f64 = 1.0;
+
 /// How a key's value is read and checked.
 #[derive(Clone, Copy)]
 enum Check {
@@ -301,6 +306,20 @@ impl Machine {
                     key,
                     format!(
                         "{v:e} mm is beyond {MAX_LENGTH_MM:e} mm: the forward kinematics' degree-8 polynomial in it would overflow"
+                    ),
+                );
+            }
+        }
+        for (key, v) in [
+            ("module.L1", m.l1),
+            ("module.L2", m.l2),
+            ("module.L3", m.l3),
+        ] {
+            if v.is_finite() && v.abs() < MIN_ROD_MM {
+                push(
+                    key,
+                    format!(
+                        "{v:e} mm is shorter than {MIN_ROD_MM} mm: machine lengths are in mm (a file in metres?), and the solvers resolve 1e-6 mm"
                     ),
                 );
             }

@@ -71,7 +71,7 @@ pub fn workspace(
         )));
     }
     if let Some(p) = plot {
-        crate::plot::Format::of_path(p).map_err(VerneError::Usage)?;
+        crate::plot::check_picture_path(p)?;
     }
     let base = WorkspaceOptions {
         lambda_bounds,
