@@ -113,6 +113,58 @@ pub fn gcode_file(data: &[u8]) {
     }
 }
 
+/// A recording (`verify --recording`), any bytes, under the first byte's choice of columns:
+/// read to its end or an error, then verified against a short path (the contour search on
+/// whatever joints the bytes hold), never a panic.
+pub fn recording(data: &[u8]) {
+    use crate::input::recording::{RecordingReader, parse_columns};
+    use nalgebra::Vector3;
+    use verne::verify::contour::{ContourPath, verify_recording};
+    use verne::verify::{PathPoint, RowSource, Thresholds, VerifyOptions};
+    let Some((&choice, rest)) = data.split_first() else {
+        return;
+    };
+    let columns = [
+        "rho1,rho2,rho3,theta1,theta2",
+        "tag,rho1,rho2,rho3,theta1,theta2,_,_",
+        "theta2,_,rho3,tag,rho1,theta1,rho2",
+    ][usize::from(choice % 3)];
+    let open = || {
+        RecordingReader::from_reader(
+            Box::new(std::io::Cursor::new(rest.to_vec())),
+            "fuzz.txt",
+            parse_columns(columns).expect("valid columns"),
+            0.001,
+        )
+    };
+    let mut reader = open();
+    for _ in 0..100_000 {
+        match reader.next_item() {
+            Ok(Some(_)) => {}
+            _ => break,
+        }
+    }
+    let machine = verne::spec::Machine::default_verne();
+    let Ok(thresholds) = Thresholds::from_machine(&machine, "fuzz") else {
+        return;
+    };
+    let opt = VerifyOptions {
+        thresholds,
+        tool_length: machine.tool_length,
+    };
+    let path = ContourPath::new(vec![
+        PathPoint::new(Vector3::new(0.0, 0.0, 100.0), Vector3::z()),
+        PathPoint::new(Vector3::new(20.0, 10.0, 80.0), Vector3::z()),
+        PathPoint::new(
+            Vector3::new(40.0, 10.0, 80.0),
+            verne::machine::orientation::tool_axis(0.2, 0.8),
+        ),
+    ]);
+    let mut report =
+        |_: &verne::verify::Violation| -> Result<(), crate::error::VerneError> { Ok(()) };
+    let _ = verify_recording(&machine, &opt, &mut open(), path, "path", &mut report);
+}
+
 /// The command-line value parsers, on any text.
 pub fn arg_values(data: &[u8]) {
     if let Ok(text) = std::str::from_utf8(data) {

@@ -29,6 +29,7 @@ fn fuzz_corpus_replays_without_panics() {
         replay("apt_file", verne_cli::fuzz_entry::apt_file),
         replay("gcode_file", verne_cli::fuzz_entry::gcode_file),
         replay("arg_values", verne_cli::fuzz_entry::arg_values),
+        replay("recording", verne_cli::fuzz_entry::recording),
     ];
     for c in counts {
         assert!(c > 0, "every target has a corpus");

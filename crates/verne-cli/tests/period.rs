@@ -167,3 +167,58 @@ fn what_cannot_be_timed_is_refused() {
     let out = run(&["ik", "data/example.cl", "--period", "1ns"], None);
     assert_eq!(out.status.code(), Some(2));
 }
+
+/// With --period the samples are timed by the feeds, so the travel summary gives each joint's
+/// largest speed: equal to the largest change per period in the stream itself.
+#[test]
+fn the_travel_summary_gives_the_joint_speeds_of_a_timed_stream() {
+    let dir = std::env::temp_dir().join(format!("verne-period-speeds-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("stream.hal");
+    let out = common::run(
+        &[
+            "ik",
+            "data/example.cl",
+            "--format",
+            "halstreamer",
+            "--period",
+            "1ms",
+            "--rapid",
+            "5000",
+            "-o",
+            file.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert_eq!(out.status.code(), Some(0));
+    let err = String::from_utf8_lossy(&out.stderr);
+    let speeds = err
+        .split("largest speeds ")
+        .nth(1)
+        .unwrap_or_else(|| panic!("no speeds: {err}"));
+    let printed: Vec<f64> = speeds
+        .split(|c: char| c == ',' || c.is_whitespace())
+        .filter_map(|w| w.parse().ok())
+        .collect();
+    assert_eq!(printed.len(), 5, "{speeds}");
+    let rows: Vec<Vec<f64>> = std::fs::read_to_string(&file)
+        .unwrap()
+        .lines()
+        .map(|l| l.split_whitespace().map(|v| v.parse().unwrap()).collect())
+        .collect();
+    for k in 0..5 {
+        let largest = rows
+            .windows(2)
+            .map(|w| (w[1][k] - w[0][k]).abs() / 0.001)
+            .fold(0.0, f64::max);
+        assert!(
+            (largest - printed[k]).abs() < 1e-3,
+            "joint {k}: {largest} vs {}",
+            printed[k]
+        );
+    }
+    // Without --period the rows are path points, not timed: no speeds are claimed.
+    let out = common::run(&["ik", "data/example.cl"], None);
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("largest speeds"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

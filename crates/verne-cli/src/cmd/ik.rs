@@ -109,6 +109,7 @@ pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
             };
             let mut job = MachineIk::new(machine, tool_length, orientation, args.all, first);
             job.offset = offset;
+            job.travel.period = args.period;
             if let Some(theta2) = seed {
                 job.state = PathState::with_theta2(first, theta2);
             }

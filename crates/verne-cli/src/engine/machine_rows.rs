@@ -70,7 +70,12 @@ pub struct JointTravel {
     pub theta2_travel: f64,
     /// Rows flagged `near_rotary_singularity` (the tool axis near the rotary axis).
     pub near_rotary_singularity: u64,
-    last_theta2: Option<f64>,
+    /// The servo period (s) when the rows are samples at it (`--period`): the joints' speeds
+    /// are then known, the feeds having timed the samples.
+    pub period: Option<f64>,
+    /// Largest |change| per period of each joint (mm/s, rad/s), with `period`.
+    pub max_speed: [f64; 5],
+    last: Option<[f64; 5]>,
 }
 
 impl JointTravel {
@@ -83,10 +88,15 @@ impl JointTravel {
             *lo = lo.min(v);
             *hi = hi.max(v);
         }
-        if let Some(t) = self.last_theta2 {
-            self.theta2_travel += (q[4] - t).abs();
+        if let Some(last) = self.last {
+            self.theta2_travel += (q[4] - last[4]).abs();
+            if let Some(period) = self.period {
+                for k in 0..5 {
+                    self.max_speed[k] = self.max_speed[k].max((q[k] - last[k]).abs() / period);
+                }
+            }
         }
-        self.last_theta2 = Some(q[4]);
+        self.last = Some(q);
         self.rows += 1;
     }
 
@@ -118,8 +128,22 @@ impl JointTravel {
             self.max[4].to_degrees(),
             self.theta2_travel / std::f64::consts::TAU
         ));
+        let speeds = match self.period {
+            Some(_) => {
+                let s = &self.max_speed;
+                format!(
+                    "; largest speeds rho1 {:.3}, rho2 {:.3}, rho3 {:.3} mm/s, theta1 {:.3}, theta2 {:.3} deg/s",
+                    s[0],
+                    s[1],
+                    s[2],
+                    s[3].to_degrees(),
+                    s[4].to_degrees()
+                )
+            }
+            None => String::new(),
+        };
         format!(
-            "joint travel over {} ok rows: {}; {} rows near the rotary-axis singularity",
+            "joint travel over {} ok rows: {}; {} rows near the rotary-axis singularity{speeds}",
             self.rows,
             parts.join(", "),
             self.near_rotary_singularity

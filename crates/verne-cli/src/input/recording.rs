@@ -81,15 +81,25 @@ impl RecordingReader {
             let f = crate::table::open_input_file(path).map_err(|e| VerneError::io(&name, e))?;
             Box::new(std::io::BufReader::with_capacity(64 * 1024, f))
         };
-        Ok(RecordingReader {
+        Ok(Self::from_reader(input, &name, columns, period))
+    }
+
+    /// A recording from any reader (`name` for messages).
+    pub fn from_reader(
+        input: Box<dyn BufRead + Send>,
+        name: &str,
+        columns: Vec<Column>,
+        period: f64,
+    ) -> Self {
+        RecordingReader {
             input,
-            name,
+            name: name.to_string(),
             columns,
             period,
             line: 0,
             index: 0,
             buf: Vec::new(),
-        })
+        }
     }
 
     fn error(&self, column: Option<&str>, message: String) -> VerneError {
