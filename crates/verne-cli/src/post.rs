@@ -3,8 +3,9 @@
 //! block of a joint program: the five joints by the letters of the machine file's `[gcode]`
 //! table, `G0` for rapids, and for feed moves `G93` inverse time, so that each block takes the
 //! time of the tool tip's move at the path's feed (LinuxCNC's rule for moves of the rotary
-//! axes alone: their angle at the feed in degrees per minute). `verne verify --joints` reads
-//! the program back, one row per block.
+//! axes alone: their angle at the feed in degrees per minute), or the time the path states for
+//! the move (a tool-centre program's `G93` block, the `dt` column). `verne verify --joints`
+//! reads the program back, one row per block.
 
 use std::io::{self, Write};
 
@@ -22,6 +23,8 @@ struct Columns {
     n: Option<usize>,
     motion: Option<usize>,
     feed: Option<usize>,
+    /// The time of the move (s) where the path states it (a program's G93 block).
+    dt: Option<usize>,
     tip: [usize; 3],
     joints: [usize; 5],
 }
@@ -69,6 +72,7 @@ impl GcodePost {
             n: find("n"),
             motion: find("motion"),
             feed: find("feed"),
+            dt: find("dt"),
             tip: [need("x")?, need("y")?, need("z")?],
             joints: [
                 need("rho1")?,
@@ -158,7 +162,19 @@ impl GcodePost {
         for (w, v) in self.words.joints.iter().zip(joints) {
             write!(self.block, " {}{}", w.letter, number(w.word(v)))?;
         }
-        if !rapid {
+        let stated =
+            c.dt.and_then(|i| fields.get(i))
+                .and_then(|t| t.parse::<f64>().ok())
+                .filter(|t| t.is_finite() && *t >= 0.0);
+        if let (false, Some(seconds)) = (rapid, stated) {
+            // The path states the move's time (a G93 block): the joint block takes it.
+            let f = if seconds > 0.0 {
+                60.0 / seconds
+            } else {
+                STILL_F
+            };
+            write!(self.block, " F{}", number(f))?;
+        } else if !rapid {
             let feed = c
                 .feed
                 .and_then(|i| fields.get(i))

@@ -344,3 +344,58 @@ fn ik_reports_where_the_joints_went() {
         "{line}"
     );
 }
+
+/// A tool-centre program with a `G93` block (its own time of the move) is posted with that time:
+/// the joint block's inverse-time F is 60 / dt (it was refused for want of a feed), and the post
+/// verifies against the program row for row.
+#[test]
+fn a_g93_block_is_posted_with_the_time_the_program_states() {
+    let dir = std::env::temp_dir().join(format!("verne-g93-post-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let post = dir.join("post.ngc");
+    let program = "tests/data/gcode/tcp-inch-cycles.ngc";
+    let out = common::run(
+        &[
+            "ik",
+            program,
+            "--format",
+            "gcode",
+            "-o",
+            post.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&post).unwrap();
+    // N15 G93 G1 X8. Y3. Z1. F30.: inverse time 30/min, 2 s.
+    let n15 = text.lines().find(|l| l.starts_with("N15 ")).unwrap();
+    assert!(n15.ends_with(" F30"), "{n15}");
+    let out = common::run(
+        &[
+            "verify",
+            "--joints",
+            post.to_str().unwrap(),
+            "--path",
+            program,
+        ],
+        None,
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("51 rows, 50 segments checked"), "{err}");
+    for check in [
+        "pairing",
+        "tip_error",
+        "axis_error",
+        "velocity",
+        "acceleration",
+    ] {
+        let line = err.lines().find(|l| l.starts_with(check)).unwrap();
+        assert_eq!(line.split_whitespace().nth(1), Some("0"), "{line}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
