@@ -2,6 +2,7 @@
 //! for a person or as CSV: a tool pose or machine joints of the 5-axis machine, a platform point
 //! or sliders of the parallel module.
 
+use crate::engine::machine_rows::machine_fk_parts;
 use crate::engine::pipeline::{Cell, Units, write_cell};
 use crate::error::VerneError;
 use crate::plot::{BranchSketch, branches_picture};
@@ -112,25 +113,18 @@ fn proof(c: Certificate) -> &'static str {
 
 /// An angle column's name with its unit.
 fn angle_column(name: &'static str, u: Units) -> &'static str {
-    let deg = [
-        ("alpha", "alpha_deg"),
-        ("theta1", "theta1_deg"),
-        ("theta2", "theta2_deg"),
-        ("phi1", "phi1_deg"),
-        ("phi2", "phi2_deg"),
+    // (name, in degrees, in radians)
+    const ANGLES: [(&str, &str, &str); 5] = [
+        ("alpha", "alpha_deg", "alpha_rad"),
+        ("theta1", "theta1_deg", "theta1_rad"),
+        ("theta2", "theta2_deg", "theta2_rad"),
+        ("phi1", "phi1_deg", "phi1_rad"),
+        ("phi2", "phi2_deg", "phi2_rad"),
     ];
-    let rad = [
-        ("alpha", "alpha_rad"),
-        ("theta1", "theta1_rad"),
-        ("theta2", "theta2_rad"),
-        ("phi1", "phi1_rad"),
-        ("phi2", "phi2_rad"),
-    ];
-    let table = if u.radians { rad } else { deg };
-    table
+    ANGLES
         .iter()
-        .find(|(n, _)| *n == name)
-        .map_or(name, |(_, c)| c)
+        .find(|(n, _, _)| *n == name)
+        .map_or(name, |(_, deg, rad)| if u.radians { rad } else { deg })
 }
 
 /// The columns of [`module_cells`]: with the sliders or without (where they are the query).
@@ -380,17 +374,8 @@ fn machine_fk_listing(machine: &Machine, j: &[f64; 5], tool_length: f64, u: Unit
     let mut rows = Vec::new();
     let mut sketches = Vec::new();
     for (k, m) in modes.iter().enumerate() {
-        let mut row = vec![
-            Cell::Int(k as i64 + 1),
-            Cell::Num(m.tool.tip.x),
-            Cell::Num(m.tool.tip.y),
-            Cell::Num(m.tool.tip.z),
-            Cell::Num(m.axis.x),
-            Cell::Num(m.axis.y),
-            Cell::Num(m.axis.z),
-            Cell::Angle(m.tool.phi1),
-            Cell::Angle(m.tool.phi2),
-        ];
+        let mut row = vec![Cell::Int(k as i64 + 1)];
+        row.extend(machine_fk_parts(m).0);
         row.extend(module_cells(&m.module, None, m.config));
         row.extend(figure_cells(machine, &m.module, &rho, m.verdict));
         rows.push(row);

@@ -427,8 +427,9 @@ fn working_machine_mode(modes: &MachineFkModes) -> Option<&MachineFkMode> {
         .min_by(|a, b| a.module.alpha.abs().total_cmp(&b.module.alpha.abs()))
 }
 
-/// The written values of a machine assembly mode.
-fn machine_fk_parts(m: &MachineFkMode) -> ([Cell; 8], Config, Verdict) {
+/// The written values of a machine assembly mode: tip, axis, phi1, phi2 (also `verne modes
+/// --machine-joints`).
+pub(crate) fn machine_fk_parts(m: &MachineFkMode) -> ([Cell; 8], Config, Verdict) {
     let values = [
         Cell::Num(m.tool.tip.x),
         Cell::Num(m.tool.tip.y),

@@ -47,6 +47,13 @@ fn guides(spec: &GliderSpec) -> [(Point2<f64>, Vector2<f64>, [f64; 2]); 2] {
     ]
 }
 
+/// The guides' origins and stroke ends, which every picture shows.
+fn guide_points(spec: &GliderSpec) -> impl Iterator<Item = Point2<f64>> {
+    guides(spec)
+        .into_iter()
+        .flat_map(|(o, u, [r0, r1])| [o, o + u * r0, o + u * r1])
+}
+
 /// A window around the points, padded, as ((x0, x1), (y0, y1)).
 fn window(points: impl Iterator<Item = Point2<f64>>) -> ((f64, f64), (f64, f64)) {
     let (mut lo, mut hi) = (
@@ -115,10 +122,7 @@ pub fn workspace_picture(
             grid.origin.y + (grid.ny.max(1) - 1) as f64 * grid.step + half,
         ),
     ];
-    let guide_points = guides(spec)
-        .into_iter()
-        .flat_map(|(o, u, [r0, r1])| [o, o + u * r0, o + u * r1]);
-    let win = window(corners.into_iter().chain(guide_points));
+    let win = window(corners.into_iter().chain(guide_points(spec)));
     let height = equal_scale_height(CHART_WIDTH_PX, win);
     let size = (
         CHART_WIDTH_PX + AXIS_ROOM_PX + 20,
@@ -187,74 +191,72 @@ pub fn workspace_picture(
         path,
         size,
         |root: &DrawingArea<_, Shift>| -> Result<(), String> {
-            {
-                root.fill(&WHITE).map_err(drawing)?;
-                let (top, body) = root.split_vertically(LEGEND_HEIGHT_PX);
-                draw_title_and_legend(&top, &title, &entries)?;
-                let mut c = chart(&body, win, unit, 12)?;
-                // Run-length rectangles along each grid row.
-                let mut cells = Vec::new();
-                for j in 0..grid.ny {
-                    let mut i = 0;
-                    while i < grid.nx {
-                        let fill = colour(j * grid.nx + i);
-                        let start = i;
-                        while i < grid.nx && colour(j * grid.nx + i) == fill {
-                            i += 1;
-                        }
-                        if let Some(fill) = fill {
-                            let x0 = grid.origin.x + start as f64 * grid.step - half;
-                            let x1 = grid.origin.x + (i - 1) as f64 * grid.step + half;
-                            let y = grid.origin.y + j as f64 * grid.step;
-                            cells.push(Rectangle::new(
-                                [(x0, y - half), (x1, y + half)],
-                                fill.filled(),
-                            ));
-                        }
+            root.fill(&WHITE).map_err(drawing)?;
+            let (top, body) = root.split_vertically(LEGEND_HEIGHT_PX);
+            draw_title_and_legend(&top, &title, &entries)?;
+            let mut c = chart(&body, win, unit, 12)?;
+            // Run-length rectangles along each grid row.
+            let mut cells = Vec::new();
+            for j in 0..grid.ny {
+                let mut i = 0;
+                while i < grid.nx {
+                    let fill = colour(j * grid.nx + i);
+                    let start = i;
+                    while i < grid.nx && colour(j * grid.nx + i) == fill {
+                        i += 1;
+                    }
+                    if let Some(fill) = fill {
+                        let x0 = grid.origin.x + start as f64 * grid.step - half;
+                        let x1 = grid.origin.x + (i - 1) as f64 * grid.step + half;
+                        let y = grid.origin.y + j as f64 * grid.step;
+                        cells.push(Rectangle::new(
+                            [(x0, y - half), (x1, y + half)],
+                            fill.filled(),
+                        ));
                     }
                 }
-                c.draw_series(cells).map_err(drawing)?;
-                let outline = |r: &Region| {
-                    let mut p: Vec<(f64, f64)> = r.corners().iter().map(|c| (c.x, c.y)).collect();
-                    p.push(p[0]);
-                    p
-                };
-                if let Some(r) = &rect {
-                    c.draw_series(std::iter::once(PathElement::new(
-                        outline(r),
-                        RECTANGLE.stroke_width(2),
-                    )))
-                    .map_err(drawing)?;
-                }
-                if let (Some(s), false) = (&square, same) {
-                    c.draw_series(DashedLineSeries::new(
-                        outline(s),
-                        8,
-                        5,
-                        SQUARE.stroke_width(2),
-                    ))
-                    .map_err(drawing)?;
-                }
-                for (o, u, [r0, r1]) in guides(spec) {
-                    let (a, b) = (o + u * r0, o + u * r1);
-                    c.draw_series(std::iter::once(PathElement::new(
-                        vec![(a.x, a.y), (b.x, b.y)],
-                        GUIDE.stroke_width(4),
-                    )))
-                    .map_err(drawing)?;
-                    c.draw_series(std::iter::once(Circle::new((o.x, o.y), 4, GUIDE.filled())))
-                        .map_err(drawing)?;
-                }
-                for (o, name) in [(spec.a(), "A"), (spec.b(), "B")] {
-                    c.draw_series(std::iter::once(Text::new(
-                        name,
-                        (o.x, o.y - 0.02 * (win.1.1 - win.1.0)),
-                        (FAMILY, 13).into_font().color(&GUIDE),
-                    )))
-                    .map_err(drawing)?;
-                }
-                Ok(())
             }
+            c.draw_series(cells).map_err(drawing)?;
+            let outline = |r: &Region| {
+                let mut p: Vec<(f64, f64)> = r.corners().iter().map(|c| (c.x, c.y)).collect();
+                p.push(p[0]);
+                p
+            };
+            if let Some(r) = &rect {
+                c.draw_series(std::iter::once(PathElement::new(
+                    outline(r),
+                    RECTANGLE.stroke_width(2),
+                )))
+                .map_err(drawing)?;
+            }
+            if let (Some(s), false) = (&square, same) {
+                c.draw_series(DashedLineSeries::new(
+                    outline(s),
+                    8,
+                    5,
+                    SQUARE.stroke_width(2),
+                ))
+                .map_err(drawing)?;
+            }
+            for (o, u, [r0, r1]) in guides(spec) {
+                let (a, b) = (o + u * r0, o + u * r1);
+                c.draw_series(std::iter::once(PathElement::new(
+                    vec![(a.x, a.y), (b.x, b.y)],
+                    GUIDE.stroke_width(4),
+                )))
+                .map_err(drawing)?;
+                c.draw_series(std::iter::once(Circle::new((o.x, o.y), 4, GUIDE.filled())))
+                    .map_err(drawing)?;
+            }
+            for (o, name) in [(spec.a(), "A"), (spec.b(), "B")] {
+                c.draw_series(std::iter::once(Text::new(
+                    name,
+                    (o.x, o.y - 0.02 * (win.1.1 - win.1.0)),
+                    (FAMILY, 13).into_font().color(&GUIDE),
+                )))
+                .map_err(drawing)?;
+            }
+            Ok(())
         }
     )
 }
@@ -295,10 +297,7 @@ pub fn branches_picture(
         let [c, d] = sliders(b);
         [b.p, c, d]
     });
-    let guide_points = guides(spec)
-        .into_iter()
-        .flat_map(|(o, u, [r0, r1])| [o, o + u * r0, o + u * r1]);
-    let win = window(points.chain(guide_points));
+    let win = window(points.chain(guide_points(spec)));
     let panel_width = 330;
     let panel_height = equal_scale_height(panel_width - 70, win) + 110;
     let size = (
@@ -320,59 +319,57 @@ pub fn branches_picture(
         path,
         size,
         |root: &DrawingArea<_, Shift>| -> Result<(), String> {
-            {
-                root.fill(&WHITE).map_err(drawing)?;
-                let (top, body) = root.split_vertically(LEGEND_HEIGHT_PX);
-                draw_title_and_legend(&top, title, &entries)?;
-                for (panel, b) in body.split_evenly((rows, cols)).iter().zip(branches) {
-                    panel
-                        .draw(&Text::new(b.label.clone(), (10, 6), (FAMILY, 14)))
-                        .map_err(drawing)?;
-                    panel
-                        .draw(&Text::new(
-                            b.detail.replace(';', ", "),
-                            (10, 24),
-                            (FAMILY, 11),
-                        ))
-                        .map_err(drawing)?;
-                    let inner = panel.margin(40, 0, 0, 0);
-                    let mut c = chart(&inner, win, unit, 10)?;
-                    for (o, u, [r0, r1]) in guides(spec) {
-                        let (a, e) = (o + u * r0, o + u * r1);
-                        c.draw_series(std::iter::once(PathElement::new(
-                            vec![(a.x, a.y), (e.x, e.y)],
-                            GUIDE.stroke_width(3),
-                        )))
-                        .map_err(drawing)?;
-                    }
-                    let [sc, sd] = sliders(b);
-                    for (s, col) in [(sc, RECTANGLE), (sd, SQUARE)] {
-                        c.draw_series(std::iter::once(PathElement::new(
-                            vec![(s.x, s.y), (b.p.x, b.p.y)],
-                            col.stroke_width(2),
-                        )))
-                        .map_err(drawing)?;
-                        c.draw_series(std::iter::once(Circle::new((s.x, s.y), 5, col.filled())))
-                            .map_err(drawing)?;
-                    }
-                    c.draw_series(std::iter::once(Circle::new(
-                        (b.p.x, b.p.y),
-                        4,
-                        BLACK.filled(),
+            root.fill(&WHITE).map_err(drawing)?;
+            let (top, body) = root.split_vertically(LEGEND_HEIGHT_PX);
+            draw_title_and_legend(&top, title, &entries)?;
+            for (panel, b) in body.split_evenly((rows, cols)).iter().zip(branches) {
+                panel
+                    .draw(&Text::new(b.label.clone(), (10, 6), (FAMILY, 14)))
+                    .map_err(drawing)?;
+                panel
+                    .draw(&Text::new(
+                        b.detail.replace(';', ", "),
+                        (10, 24),
+                        (FAMILY, 11),
+                    ))
+                    .map_err(drawing)?;
+                let inner = panel.margin(40, 0, 0, 0);
+                let mut c = chart(&inner, win, unit, 10)?;
+                for (o, u, [r0, r1]) in guides(spec) {
+                    let (a, e) = (o + u * r0, o + u * r1);
+                    c.draw_series(std::iter::once(PathElement::new(
+                        vec![(a.x, a.y), (e.x, e.y)],
+                        GUIDE.stroke_width(3),
                     )))
                     .map_err(drawing)?;
-                    if b.working {
-                        let (w, h) = panel.dim_in_pixel();
-                        panel
-                            .draw(&Rectangle::new(
-                                [(1, 1), (w as i32 - 2, h as i32 - 2)],
-                                REGION.stroke_width(3),
-                            ))
-                            .map_err(drawing)?;
-                    }
                 }
-                Ok(())
+                let [sc, sd] = sliders(b);
+                for (s, col) in [(sc, RECTANGLE), (sd, SQUARE)] {
+                    c.draw_series(std::iter::once(PathElement::new(
+                        vec![(s.x, s.y), (b.p.x, b.p.y)],
+                        col.stroke_width(2),
+                    )))
+                    .map_err(drawing)?;
+                    c.draw_series(std::iter::once(Circle::new((s.x, s.y), 5, col.filled())))
+                        .map_err(drawing)?;
+                }
+                c.draw_series(std::iter::once(Circle::new(
+                    (b.p.x, b.p.y),
+                    4,
+                    BLACK.filled(),
+                )))
+                .map_err(drawing)?;
+                if b.working {
+                    let (w, h) = panel.dim_in_pixel();
+                    panel
+                        .draw(&Rectangle::new(
+                            [(1, 1), (w as i32 - 2, h as i32 - 2)],
+                            REGION.stroke_width(3),
+                        ))
+                        .map_err(drawing)?;
+                }
             }
+            Ok(())
         }
     )
 }

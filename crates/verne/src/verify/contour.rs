@@ -93,7 +93,13 @@ fn both(phi1: f64, phi2: f64) -> [(f64, f64); 2] {
 impl ContourPath {
     /// The path's points in order.
     pub fn new(points: Vec<PathPoint>) -> ContourPath {
-        let segments = (0..points.len().saturating_sub(1).max(points.len().min(1)))
+        // One segment per pair of points; a single point is a segment from itself to itself.
+        let count = match points.len() {
+            0 => 0,
+            1 => 1,
+            n => n - 1,
+        };
+        let segments = (0..count)
             .map(|k| {
                 let (a, b) = (&points[k], &points[(k + 1).min(points.len() - 1)]);
                 let [ea, eb] = move_angles(&a.axis, a.angles, &b.axis, b.angles);
