@@ -17,4 +17,5 @@ export VIRTUAL_ENV="$VENV"
 (cd "$ROOT/crates/verne-py" && "$VENV/bin/maturin" develop --release -q)
 export VERNE_BIN="$ROOT/target/release/verne"
 "$VENV/bin/python" -m pytest -q "$ROOT/crates/verne-py/tests" \
-    --doctest-modules "$ROOT/crates/verne-py/python/verne/__init__.py"
+    --doctest-modules "$ROOT/crates/verne-py/python/verne/__init__.py" \
+    --doctest-glob python.md "$ROOT/docs/python.md"

@@ -1,25 +1,11 @@
 """The Python package against the reference results, the `verne` command line (the oracle,
 built by scripts/python-test.sh and named by VERNE_BIN), and round trips."""
 
-import os
-import subprocess
-from pathlib import Path
-
 import numpy as np
 import pytest
+from oracle import ROOT, cli
 
 import verne
-
-ROOT = Path(__file__).resolve().parents[3]
-BIN = os.environ.get("VERNE_BIN", str(ROOT / "target" / "release" / "verne"))
-
-
-def cli(*args, stdin=None):
-    out = subprocess.run([BIN, *args], input=stdin, capture_output=True, text=True, cwd=ROOT)
-    assert out.returncode in (0, 1), out.stderr
-    lines = out.stdout.strip().splitlines()
-    header = lines[0].split(",")
-    return [dict(zip(header, line.split(","))) for line in lines[1:]]
 
 
 M = verne.Machine.default()
