@@ -22,9 +22,6 @@ type Branches<'py> = (
     Bound<'py, PyArray1<bool>>,
 );
 
-/// One real branch (or assembly mode) of a row: its four values, configuration, working flag.
-type Solution = ([f64; 4], [i8; 3], bool);
-
 /// `module_ik_working`'s result: sliders, alpha, status.
 type Working<'py> = (
     Bound<'py, PyArray2<f64>>,
@@ -32,117 +29,173 @@ type Working<'py> = (
     Bound<'py, PyArray1<i8>>,
 );
 
-/// Every branch of every row, solved in parallel chunks into compact per-chunk lists:
-/// the solutions in row order, and per row its count and certificate. `solve_chunk` solves a
-/// chunk of rows, appending to the three lists.
-fn solve_compact<T: Sync>(
-    rows: &[T],
-    solve_chunk: impl Fn(&[T], &mut Vec<Solution>, &mut Vec<usize>, &mut Vec<bool>) + Sync,
-) -> (Vec<Solution>, Vec<usize>, Vec<bool>) {
-    let chunks: Vec<(Vec<Solution>, Vec<usize>, Vec<bool>)> = rows
-        .par_chunks(CHUNK)
-        .map(|chunk| {
-            let mut sols = Vec::with_capacity(chunk.len() * 8);
-            let mut counts = Vec::with_capacity(chunk.len());
-            let mut proved = Vec::with_capacity(chunk.len());
-            solve_chunk(chunk, &mut sols, &mut counts, &mut proved);
-            (sols, counts, proved)
-        })
-        .collect();
-    let mut sols = Vec::with_capacity(chunks.iter().map(|c| c.0.len()).sum());
-    let mut counts = Vec::with_capacity(rows.len());
-    let mut proved = Vec::with_capacity(rows.len());
-    for (s, c, p) in chunks {
-        sols.extend(s);
-        counts.extend(c);
-        proved.extend(p);
+/// The real branches (or assembly modes) of a chunk of rows, in row order: per branch its four
+/// values, configuration and working flag, per row its count and certificate.
+#[derive(Default)]
+struct Solved {
+    values: Vec<[f64; 4]>,
+    config: Vec<[i8; 3]>,
+    working: Vec<bool>,
+    counts: Vec<usize>,
+    proved: Vec<bool>,
+}
+
+impl Solved {
+    fn push(&mut self, values: [f64; 4], config: [i8; 3], working: bool) {
+        self.values.push(values);
+        self.config.push(config);
+        self.working.push(working);
     }
-    (sols, counts, proved)
+}
+
+/// Points whose branch lists are solved together inside a chunk: the lists (about 1.3 KB each)
+/// are reused from batch to batch and stay in cache.
+const LIST_BATCH: usize = 64;
+
+/// Every branch of every row, solved in parallel chunks of [`CHUNK`] rows, one [`Solved`] per
+/// chunk in order. `solve_chunk` solves a chunk of rows into its `Solved`.
+fn solve_chunks<T: Sync>(
+    rows: &[T],
+    solve_chunk: impl Fn(&[T], &mut Solved) + Sync,
+) -> Vec<Solved> {
+    rows.par_chunks(CHUNK)
+        .map(|chunk| {
+            let mut out = Solved {
+                values: Vec::with_capacity(chunk.len() * 16),
+                config: Vec::with_capacity(chunk.len() * 16),
+                working: Vec::with_capacity(chunk.len() * 16),
+                counts: Vec::with_capacity(chunk.len()),
+                proved: Vec::with_capacity(chunk.len()),
+            };
+            solve_chunk(chunk, &mut out);
+            out
+        })
+        .collect()
 }
 
 /// Every branch of a chunk of points, four at a time through the core's batched kernel
 /// (`ik::solve_each`, the one `verne ik --all` runs).
-fn ik_chunk(
-    m: &Machine,
-    chunk: &[[f64; 3]],
-    sols: &mut Vec<Solution>,
-    counts: &mut Vec<usize>,
-    proved: &mut Vec<bool>,
-) {
-    let mut lists = vec![ik::IkBranches::default(); chunk.len()];
-    ik::solve_each(
-        m,
-        chunk
-            .iter()
-            .map(|p| nalgebra::Vector3::from(*p))
-            .zip(lists.iter_mut()),
-    );
-    for s in &lists {
-        for br in s.iter() {
-            sols.push((
-                [br.rho.x, br.rho.y, br.rho.z, br.alpha],
-                br.config,
-                br.working(),
-            ));
+fn ik_chunk(m: &Machine, chunk: &[[f64; 3]], out: &mut Solved) {
+    let mut lists = vec![ik::IkBranches::default(); LIST_BATCH.min(chunk.len())];
+    for points in chunk.chunks(LIST_BATCH) {
+        ik::solve_each(
+            m,
+            points
+                .iter()
+                .map(|p| nalgebra::Vector3::from(*p))
+                .zip(lists.iter_mut()),
+        );
+        for s in &lists[..points.len()] {
+            for br in s.iter() {
+                out.push(
+                    [br.rho.x, br.rho.y, br.rho.z, br.alpha],
+                    br.config,
+                    br.working(),
+                );
+            }
+            out.counts.push(s.len());
+            out.proved.push(s.certificate.proved());
         }
-        counts.push(s.len());
-        proved.push(s.certificate.proved());
     }
 }
 
 /// Every assembly mode of a chunk of slider triples.
-fn fk_chunk(
-    m: &Machine,
-    chunk: &[[f64; 3]],
-    sols: &mut Vec<Solution>,
-    counts: &mut Vec<usize>,
-    proved: &mut Vec<bool>,
-) {
+fn fk_chunk(m: &Machine, chunk: &[[f64; 3]], out: &mut Solved) {
     for r in chunk {
         let s = fk::solve(m, &Sliders::new(r[0], r[1], r[2]));
         for mode in s.iter() {
             let p = mode.pose.p;
-            sols.push((
+            out.push(
                 [p.x, p.y, p.z, mode.pose.alpha],
                 mode.config,
                 mode.working(),
-            ));
+            );
         }
-        counts.push(s.len());
-        proved.push(s.certificate.proved());
+        out.counts.push(s.len());
+        out.proved.push(s.certificate.proved());
     }
 }
 
-/// Compact solutions as NaN-padded `[N, K, ...]` arrays.
-fn padded<'py>(
-    py: Python<'py>,
-    (sols, counts, proved): (Vec<Solution>, Vec<usize>, Vec<bool>),
-    k: usize,
-) -> Branches<'py> {
-    let n = counts.len();
-    let mut b = Array3::<f64>::from_elem((n, k, 4), f64::NAN);
+/// `slice` cut into consecutive pieces of the given lengths.
+fn split_by<T>(mut slice: &mut [T], lens: impl Iterator<Item = usize>) -> Vec<&mut [T]> {
+    let mut pieces = Vec::new();
+    for len in lens {
+        let (piece, rest) = std::mem::take(&mut slice).split_at_mut(len);
+        pieces.push(piece);
+        slice = rest;
+    }
+    pieces
+}
+
+/// Every branch as NaN-padded `[N, K, ...]` arrays, before they are handed to Python.
+type PaddedArrays = (
+    Array3<f64>,
+    Array3<i8>,
+    Array2<bool>,
+    Array1<i64>,
+    Array1<bool>,
+);
+
+/// The chunks' solutions as padded arrays, each chunk written into its rows in parallel (the
+/// arrays start zeroed by the allocator, so only the written pages are touched twice).
+fn padded(chunks: Vec<Solved>, n: usize, k: usize) -> PaddedArrays {
+    let mut b = Array3::<f64>::zeros((n, k, 4));
     let mut c = Array3::<i8>::zeros((n, k, 3));
     let mut w = Array2::<bool>::from_elem((n, k), false);
-    let mut next = 0;
-    for (i, &count) in counts.iter().enumerate() {
-        for (slot, (v, config, working)) in sols[next..next + count].iter().enumerate() {
-            for j in 0..4 {
-                b[[i, slot, j]] = v[j];
+    let mut count = Array1::<i64>::zeros(n);
+    let mut proved = Array1::<bool>::from_elem(n, false);
+    let rows_of = |s: &Solved| s.counts.len();
+    let bs = split_by(
+        b.as_slice_mut().expect("a new array is contiguous"),
+        chunks.iter().map(|s| rows_of(s) * k * 4),
+    );
+    let cs = split_by(
+        c.as_slice_mut().expect("a new array is contiguous"),
+        chunks.iter().map(|s| rows_of(s) * k * 3),
+    );
+    let ws = split_by(
+        w.as_slice_mut().expect("a new array is contiguous"),
+        chunks.iter().map(|s| rows_of(s) * k),
+    );
+    let ns = split_by(
+        count.as_slice_mut().expect("a new array is contiguous"),
+        chunks.iter().map(rows_of),
+    );
+    let ps = split_by(
+        proved.as_slice_mut().expect("a new array is contiguous"),
+        chunks.iter().map(rows_of),
+    );
+    bs.into_par_iter()
+        .zip(cs)
+        .zip(ws)
+        .zip(ns)
+        .zip(ps)
+        .zip(&chunks)
+        .for_each(|(((((b, c), w), n), p), s)| {
+            b.fill(f64::NAN);
+            let mut next = 0;
+            for (i, &count) in s.counts.iter().enumerate() {
+                for slot in 0..count {
+                    let (row, at) = (next + slot, i * k + slot);
+                    b[4 * at..4 * at + 4].copy_from_slice(&s.values[row]);
+                    c[3 * at..3 * at + 3].copy_from_slice(&s.config[row]);
+                    w[at] = s.working[row];
+                }
+                n[i] = count as i64;
+                next += count;
             }
-            for j in 0..3 {
-                c[[i, slot, j]] = config[j];
-            }
-            w[[i, slot]] = *working;
-        }
-        next += count;
-    }
-    let count = Array1::from_iter(counts.iter().map(|&c| c as i64));
+            p.copy_from_slice(&s.proved);
+        });
+    (b, c, w, count, proved)
+}
+
+fn padded_to_python(py: Python<'_>, (b, c, w, n, p): PaddedArrays) -> Branches<'_> {
     (
         b.into_pyarray(py),
         c.into_pyarray(py),
         w.into_pyarray(py),
-        count.into_pyarray(py),
-        Array1::from_vec(proved).into_pyarray(py),
+        n.into_pyarray(py),
+        p.into_pyarray(py),
     )
 }
 
@@ -155,38 +208,87 @@ type Compact<'py> = (
     Bound<'py, PyArray1<bool>>,
 );
 
-/// Compact solutions: one row per real branch, as the CLI's `--all` rows.
-fn compact<'py>(
-    py: Python<'py>,
-    (sols, counts, proved): (Vec<Solution>, Vec<usize>, Vec<bool>),
-) -> Compact<'py> {
-    let m = sols.len();
-    let mut b = Array2::<f64>::zeros((m, 4));
-    let mut c = Array2::<i8>::zeros((m, 3));
-    let mut w = Array1::<bool>::from_elem(m, false);
-    for (r, (v, config, working)) in sols.iter().enumerate() {
-        for j in 0..4 {
-            b[[r, j]] = v[j];
-        }
-        for j in 0..3 {
-            c[[r, j]] = config[j];
-        }
-        w[r] = *working;
+/// One row per real branch, before the arrays are handed to Python.
+type CompactArrays = (
+    Array2<f64>,
+    Array2<i8>,
+    Array1<bool>,
+    Array1<i64>,
+    Array1<i64>,
+    Array1<bool>,
+);
+
+/// The chunks' solutions as compact arrays, one row per real branch (as the CLI's `--all`
+/// rows), each chunk copied into its rows in parallel.
+fn compact(chunks: Vec<Solved>, n: usize) -> CompactArrays {
+    let total: usize = chunks.iter().map(|s| s.values.len()).sum();
+    let mut b = Array2::<f64>::zeros((total, 4));
+    let mut c = Array2::<i8>::zeros((total, 3));
+    let mut w = Array1::<bool>::from_elem(total, false);
+    let mut index = Array1::<i64>::zeros(total);
+    let mut offsets = Array1::<i64>::zeros(n + 1);
+    let mut proved = Array1::<bool>::from_elem(n, false);
+    let sols = |s: &Solved| s.values.len();
+    let rows = |s: &Solved| s.counts.len();
+    let bs = split_by(
+        b.as_slice_mut().expect("a new array is contiguous"),
+        chunks.iter().map(|s| 4 * sols(s)),
+    );
+    let cs = split_by(
+        c.as_slice_mut().expect("a new array is contiguous"),
+        chunks.iter().map(|s| 3 * sols(s)),
+    );
+    let ws = split_by(
+        w.as_slice_mut().expect("a new array is contiguous"),
+        chunks.iter().map(sols),
+    );
+    let is = split_by(
+        index.as_slice_mut().expect("a new array is contiguous"),
+        chunks.iter().map(sols),
+    );
+    let ps = split_by(
+        proved.as_slice_mut().expect("a new array is contiguous"),
+        chunks.iter().map(rows),
+    );
+    bs.into_par_iter()
+        .zip(cs)
+        .zip(ws)
+        .zip(is)
+        .zip(ps)
+        .zip(&chunks)
+        .enumerate()
+        .for_each(|(k, (((((b, c), w), idx), p), s))| {
+            b.copy_from_slice(s.values.as_flattened());
+            c.copy_from_slice(s.config.as_flattened());
+            w.copy_from_slice(&s.working);
+            p.copy_from_slice(&s.proved);
+            let first = k * CHUNK;
+            let mut next = 0;
+            for (i, &count) in s.counts.iter().enumerate() {
+                idx[next..next + count].fill((first + i) as i64);
+                next += count;
+            }
+        });
+    let mut at = 0i64;
+    for (o, count) in offsets
+        .iter_mut()
+        .skip(1)
+        .zip(chunks.iter().flat_map(|s| s.counts.iter()))
+    {
+        at += *count as i64;
+        *o = at;
     }
-    let mut index = Vec::with_capacity(m);
-    let mut offsets = Vec::with_capacity(counts.len() + 1);
-    offsets.push(0i64);
-    for (i, &count) in counts.iter().enumerate() {
-        index.extend(std::iter::repeat_n(i as i64, count));
-        offsets.push(offsets[i] + count as i64);
-    }
+    (b, c, w, index, offsets, proved)
+}
+
+fn compact_to_python(py: Python<'_>, (b, c, w, i, o, p): CompactArrays) -> Compact<'_> {
     (
         b.into_pyarray(py),
         c.into_pyarray(py),
         w.into_pyarray(py),
-        Array1::from_vec(index).into_pyarray(py),
-        Array1::from_vec(offsets).into_pyarray(py),
-        Array1::from_vec(proved).into_pyarray(py),
+        i.into_pyarray(py),
+        o.into_pyarray(py),
+        p.into_pyarray(py),
     )
 }
 
@@ -206,8 +308,15 @@ fn module_ik<'py>(
 ) -> PyResult<Branches<'py>> {
     let pts = rows::<3>(&points, "points")?;
     let m = &machine.inner;
-    let solved = py.allow_threads(|| solve_compact(&pts, |c, s, n, p| ik_chunk(m, c, s, n, p)));
-    Ok(padded(py, solved, MAX_IK_BRANCHES))
+    let n = pts.len();
+    let arrays = py.allow_threads(|| {
+        padded(
+            solve_chunks(&pts, |c, out| ik_chunk(m, c, out)),
+            n,
+            MAX_IK_BRANCHES,
+        )
+    });
+    Ok(padded_to_python(py, arrays))
 }
 
 /// `module_ik` in compact form, one row per real branch (as `verne ik --all`): returns
@@ -221,8 +330,9 @@ fn module_ik_compact<'py>(
 ) -> PyResult<Compact<'py>> {
     let pts = rows::<3>(&points, "points")?;
     let m = &machine.inner;
-    let solved = py.allow_threads(|| solve_compact(&pts, |c, s, n, p| ik_chunk(m, c, s, n, p)));
-    Ok(compact(py, solved))
+    let n = pts.len();
+    let arrays = py.allow_threads(|| compact(solve_chunks(&pts, |c, out| ik_chunk(m, c, out)), n));
+    Ok(compact_to_python(py, arrays))
 }
 
 /// The machine's branch of the parallel module's inverse kinematics for each platform point,
@@ -240,56 +350,65 @@ fn module_ik_working<'py>(
     let pts = rows::<3>(&points, "points")?;
     let m = &machine.inner;
     let n = pts.len();
-    let mut sliders = Array2::<f64>::from_elem((n, 3), f64::NAN);
-    let mut alpha = Array1::<f64>::from_elem(n, f64::NAN);
-    let mut status = Array1::<i8>::zeros(n);
-    let solved: Vec<(Option<[f64; 4]>, i8)> = py.allow_threads(|| {
-        pts.par_chunks(CHUNK)
-            .flat_map_iter(|chunk| {
-                // The core's batched kernel (`verne ik`'s): the working branch four points at a
-                // time, every branch where its shortcut is not sure.
-                let mut lists = vec![ik::IkBranches::default(); chunk.len()];
-                let finite: Vec<bool> = chunk
-                    .iter()
-                    .map(|p| p.iter().all(|v| v.is_finite()))
-                    .collect();
-                ik::solve_working_each(
-                    m,
-                    chunk
-                        .iter()
-                        .zip(&finite)
-                        .zip(lists.iter_mut())
-                        .filter(|((_, ok), _)| **ok)
-                        .map(|((p, _), l)| (nalgebra::Vector3::from(*p), l)),
-                );
-                lists
-                    .into_iter()
-                    .zip(finite)
-                    .map(|(out, ok)| {
-                        if !ok {
-                            return (None, INVALID_INPUT);
-                        }
-                        match ik::working(&out) {
-                            Some(b) => (Some([b.rho.x, b.rho.y, b.rho.z, b.alpha]), OK),
-                            None if out.is_empty() && out.certificate.proved() => {
-                                (None, UNREACHABLE)
+    let (sliders, alpha, status) = py.allow_threads(|| {
+        let mut sliders = Array2::<f64>::zeros((n, 3));
+        let mut alpha = Array1::<f64>::zeros(n);
+        let mut status = Array1::<i8>::zeros(n);
+        let contiguous = "a new array is contiguous";
+        sliders
+            .as_slice_mut()
+            .expect(contiguous)
+            .par_chunks_mut(3 * CHUNK)
+            .zip(
+                alpha
+                    .as_slice_mut()
+                    .expect(contiguous)
+                    .par_chunks_mut(CHUNK),
+            )
+            .zip(
+                status
+                    .as_slice_mut()
+                    .expect(contiguous)
+                    .par_chunks_mut(CHUNK),
+            )
+            .zip(pts.par_chunks(CHUNK))
+            .for_each(|(((sl, al), st), chunk)| {
+                // The core's batched kernel (`verne ik`'s): the working branch four points at
+                // a time, every branch where its shortcut is not sure; the lists reused batch
+                // by batch so that they stay in cache.
+                let mut lists = vec![ik::IkBranches::default(); LIST_BATCH.min(chunk.len())];
+                for (b, points) in chunk.chunks(LIST_BATCH).enumerate() {
+                    let finite = |p: &[f64; 3]| p.iter().all(|v| v.is_finite());
+                    ik::solve_working_each(
+                        m,
+                        points
+                            .iter()
+                            .zip(lists.iter_mut())
+                            .filter(|(p, _)| finite(p))
+                            .map(|(p, l)| (nalgebra::Vector3::from(*p), l)),
+                    );
+                    for (k, (p, out)) in points.iter().zip(&lists).enumerate() {
+                        let i = b * LIST_BATCH + k;
+                        let (v, code) = if !finite(p) {
+                            (None, INVALID_INPUT)
+                        } else {
+                            match ik::working(out) {
+                                Some(b) => (Some([b.rho.x, b.rho.y, b.rho.z, b.alpha]), OK),
+                                None if out.is_empty() && out.certificate.proved() => {
+                                    (None, UNREACHABLE)
+                                }
+                                None => (None, NO_WORKING_BRANCH),
                             }
-                            None => (None, NO_WORKING_BRANCH),
-                        }
-                    })
-                    .collect::<Vec<_>>()
-            })
-            .collect()
+                        };
+                        let v = v.unwrap_or([f64::NAN; 4]);
+                        sl[3 * i..3 * i + 3].copy_from_slice(&v[..3]);
+                        al[i] = v[3];
+                        st[i] = code;
+                    }
+                }
+            });
+        (sliders, alpha, status)
     });
-    for (i, (v, st)) in solved.into_iter().enumerate() {
-        status[i] = st;
-        if let Some(v) = v {
-            for j in 0..3 {
-                sliders[[i, j]] = v[j];
-            }
-            alpha[i] = v[3];
-        }
-    }
     Ok((
         sliders.into_pyarray(py),
         alpha.into_pyarray(py),
@@ -310,8 +429,15 @@ fn module_fk<'py>(
 ) -> PyResult<Branches<'py>> {
     let rhos = rows::<3>(&sliders, "sliders")?;
     let m = &machine.inner;
-    let solved = py.allow_threads(|| solve_compact(&rhos, |c, s, n, p| fk_chunk(m, c, s, n, p)));
-    Ok(padded(py, solved, MAX_FK_MODES))
+    let n = rhos.len();
+    let arrays = py.allow_threads(|| {
+        padded(
+            solve_chunks(&rhos, |c, out| fk_chunk(m, c, out)),
+            n,
+            MAX_FK_MODES,
+        )
+    });
+    Ok(padded_to_python(py, arrays))
 }
 
 /// `module_fk` in compact form, one row per real assembly mode: as `module_ik_compact`.
@@ -323,8 +449,9 @@ fn module_fk_compact<'py>(
 ) -> PyResult<Compact<'py>> {
     let rhos = rows::<3>(&sliders, "sliders")?;
     let m = &machine.inner;
-    let solved = py.allow_threads(|| solve_compact(&rhos, |c, s, n, p| fk_chunk(m, c, s, n, p)));
-    Ok(compact(py, solved))
+    let n = rhos.len();
+    let arrays = py.allow_threads(|| compact(solve_chunks(&rhos, |c, out| fk_chunk(m, c, out)), n));
+    Ok(compact_to_python(py, arrays))
 }
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
