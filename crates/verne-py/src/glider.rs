@@ -7,6 +7,7 @@ use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray2};
 use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use rayon::prelude::*;
 
 use nalgebra::{Point2, Vector2};
 use verne::glider::{
@@ -170,27 +171,28 @@ fn glider_ik<'py>(
 ) -> PyResult<GliderSolutions<'py>> {
     let pts = rows::<2>(&points, "points")?;
     let spec = &glider.inner;
-    let solved: Vec<Vec<GliderSolution>> = pts
-        .iter()
-        .map(|p| {
-            if !p.iter().all(|v| v.is_finite()) {
-                return Vec::new();
-            }
-            let p = Point2::new(p[0], p[1]);
-            glider::inverse_kinematics(spec, p)
-                .into_iter()
-                .map(|s| {
-                    let ok = glider::verdict(spec, p, s.rho, s.mode, s.assembly).ok();
-                    (
-                        s.rho.into(),
-                        mode_signs(s.mode),
-                        s.assembly.sign() as i8,
-                        ok,
-                    )
-                })
-                .collect()
-        })
-        .collect();
+    let solved: Vec<Vec<GliderSolution>> = py.allow_threads(|| {
+        pts.par_iter()
+            .map(|p| {
+                if !p.iter().all(|v| v.is_finite()) {
+                    return Vec::new();
+                }
+                let p = Point2::new(p[0], p[1]);
+                glider::inverse_kinematics(spec, p)
+                    .into_iter()
+                    .map(|s| {
+                        let ok = glider::verdict(spec, p, s.rho, s.mode, s.assembly).ok();
+                        (
+                            s.rho.into(),
+                            mode_signs(s.mode),
+                            s.assembly.sign() as i8,
+                            ok,
+                        )
+                    })
+                    .collect()
+            })
+            .collect()
+    });
     Ok(padded(py, &solved, 4))
 }
 
@@ -206,35 +208,36 @@ fn glider_fk<'py>(
 ) -> PyResult<(GliderSolutions<'py>, Bound<'py, PyArray1<bool>>)> {
     let joints = rows::<2>(&rho, "rho")?;
     let spec = &glider.inner;
-    let mut structural = Array1::<bool>::from_elem(joints.len(), false);
-    let solved: Vec<Vec<GliderSolution>> = joints
-        .iter()
-        .enumerate()
-        .map(|(i, r)| {
-            if !r.iter().all(|v| v.is_finite()) {
-                return Vec::new();
-            }
-            let rho = Vector2::new(r[0], r[1]);
-            match glider::forward_kinematics(spec, rho) {
-                ForwardKinematics::StructuralSingularity { .. } => {
-                    structural[i] = true;
-                    Vec::new()
+    let solved: Vec<(Vec<GliderSolution>, bool)> = py.allow_threads(|| {
+        joints
+            .par_iter()
+            .map(|r| {
+                if !r.iter().all(|v| v.is_finite()) {
+                    return (Vec::new(), false);
                 }
-                ForwardKinematics::Isolated(sols) => sols
-                    .into_iter()
-                    .map(|s| {
-                        let ok = glider::verdict(spec, s.p, rho, s.mode, s.assembly).ok();
-                        (
-                            [s.p.x, s.p.y],
-                            mode_signs(s.mode),
-                            s.assembly.sign() as i8,
-                            ok,
-                        )
-                    })
-                    .collect(),
-            }
-        })
-        .collect();
+                let rho = Vector2::new(r[0], r[1]);
+                match glider::forward_kinematics(spec, rho) {
+                    ForwardKinematics::StructuralSingularity { .. } => (Vec::new(), true),
+                    ForwardKinematics::Isolated(sols) => (
+                        sols.into_iter()
+                            .map(|s| {
+                                let ok = glider::verdict(spec, s.p, rho, s.mode, s.assembly).ok();
+                                (
+                                    [s.p.x, s.p.y],
+                                    mode_signs(s.mode),
+                                    s.assembly.sign() as i8,
+                                    ok,
+                                )
+                            })
+                            .collect(),
+                        false,
+                    ),
+                }
+            })
+            .collect()
+    });
+    let structural = Array1::from_iter(solved.iter().map(|(_, s)| *s));
+    let solved: Vec<Vec<GliderSolution>> = solved.into_iter().map(|(v, _)| v).collect();
     Ok((padded(py, &solved, 2), structural.into_pyarray(py)))
 }
 
