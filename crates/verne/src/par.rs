@@ -1,6 +1,7 @@
 //! Data parallelism: with the `parallel` feature, rayon's parallel iterators; without it, the
 //! same iterator chains (`par_iter`, `into_par_iter`, `with_min_len`, `flat_map_iter`,
-//! `reduce(identity, op)`) run in order on the calling thread. The computations they carry are
+//! `par_chunks`, `par_chunks_mut`, `zip`, `for_each`, `filter`, `copied`, `count`, `fold(identity, op)`, `reduce(identity, op)`,
+//! `par_sort_unstable`) run in order on the calling thread. The computations they carry are
 //! independent per item and collected in order, so both give the same results.
 
 #[cfg(feature = "parallel")]
@@ -26,11 +27,45 @@ mod sequential {
     /// `par_iter()` for slices (and through them vectors and arrays).
     pub(crate) trait ParallelSlice<T> {
         fn par_iter(&self) -> Seq<std::slice::Iter<'_, T>>;
+        fn par_chunks(&self, size: usize) -> Seq<std::slice::Chunks<'_, T>>;
     }
 
     impl<T> ParallelSlice<T> for [T] {
         fn par_iter(&self) -> Seq<std::slice::Iter<'_, T>> {
             Seq(self.iter())
+        }
+
+        fn par_chunks(&self, size: usize) -> Seq<std::slice::Chunks<'_, T>> {
+            Seq(self.chunks(size))
+        }
+    }
+
+    /// `par_sort_unstable()` for slices.
+    pub(crate) trait ParallelSliceMut<T> {
+        fn par_sort_unstable(&mut self)
+        where
+            T: Ord;
+        fn par_chunks_mut(&mut self, size: usize) -> Seq<std::slice::ChunksMut<'_, T>>;
+    }
+
+    impl<T> ParallelSliceMut<T> for [T] {
+        fn par_sort_unstable(&mut self)
+        where
+            T: Ord,
+        {
+            self.sort_unstable()
+        }
+
+        fn par_chunks_mut(&mut self, size: usize) -> Seq<std::slice::ChunksMut<'_, T>> {
+            Seq(self.chunks_mut(size))
+        }
+    }
+
+    impl<I: Iterator> IntoIterator for Seq<I> {
+        type Item = I::Item;
+        type IntoIter = I;
+        fn into_iter(self) -> I {
+            self.0
         }
     }
 
@@ -52,6 +87,41 @@ mod sequential {
             f: F,
         ) -> Seq<std::iter::FlatMap<I, U, F>> {
             Seq(self.0.flat_map(f))
+        }
+
+        pub(crate) fn filter<P: FnMut(&I::Item) -> bool>(
+            self,
+            p: P,
+        ) -> Seq<std::iter::Filter<I, P>> {
+            Seq(self.0.filter(p))
+        }
+
+        pub(crate) fn copied<'a, T: 'a + Copy>(self) -> Seq<std::iter::Copied<I>>
+        where
+            I: Iterator<Item = &'a T>,
+        {
+            Seq(self.0.copied())
+        }
+
+        pub(crate) fn zip<J: IntoIterator>(self, other: J) -> Seq<std::iter::Zip<I, J::IntoIter>> {
+            Seq(self.0.zip(other))
+        }
+
+        pub(crate) fn for_each<F: FnMut(I::Item)>(self, f: F) {
+            self.0.for_each(f)
+        }
+
+        pub(crate) fn count(self) -> usize {
+            self.0.count()
+        }
+
+        /// One accumulator for the whole sequence (rayon makes one per piece of work).
+        pub(crate) fn fold<T, ID, F>(self, identity: ID, f: F) -> Seq<std::iter::Once<T>>
+        where
+            ID: Fn() -> T,
+            F: FnMut(T, I::Item) -> T,
+        {
+            Seq(std::iter::once(self.0.fold(identity(), f)))
         }
 
         pub(crate) fn reduce<ID, OP>(self, identity: ID, op: OP) -> I::Item

@@ -8,7 +8,7 @@
 //!   velocity of P (first three rows of -A^-1 B); the study bounds them within 1/3 .. 3.
 //! - Platform rotation rate: the fourth row of -A^-1 B (rad per mm of slider motion).
 
-use nalgebra::{Matrix3, Matrix4, RowVector3, Vector3};
+use nalgebra::{Matrix3, Matrix4, Matrix4x3, RowVector3, Vector3};
 
 use crate::parallel_module::equations::{
     ModulePose, Sliders, jacobian_pose, jacobian_sliders, rod_lengths, rod_vectors,
@@ -40,7 +40,13 @@ impl Kinetostatics {
     }
 }
 
-pub fn kinetostatics(g: &ModuleGeometry, pose: &ModulePose, rho: &Sliders) -> Kinetostatics {
+/// A and B of A dX + B drho = 0 with every row divided by 2 L_i (rows become rod directions),
+/// and the rod lengths.
+fn scaled_jacobians(
+    g: &ModuleGeometry,
+    pose: &ModulePose,
+    rho: &Sliders,
+) -> (Matrix4<f64>, Matrix4x3<f64>, [f64; 4]) {
     let mut a = jacobian_pose(g, pose, rho);
     let mut b = jacobian_sliders(g, pose, rho);
     let l = rod_lengths(g);
@@ -49,6 +55,34 @@ pub fn kinetostatics(g: &ModuleGeometry, pose: &ModulePose, rho: &Sliders) -> Ki
         a.row_mut(i).scale_mut(k);
         b.row_mut(i).scale_mut(k);
     }
+    (a, b, l)
+}
+
+/// Velocity amplification factors (largest first) and d alpha / d rho from the scaled A and B:
+/// the singular values of the first three rows of -A^-1 B, and its fourth row; infinite at a
+/// parallel singularity.
+fn velocity_map(a: &Matrix4<f64>, b: &Matrix4x3<f64>) -> ([f64; 3], RowVector3<f64>) {
+    match a.lu().solve(b) {
+        Some(x) if x.iter().all(|e| e.is_finite()) => {
+            let jp: Matrix3<f64> = -x.fixed_rows::<3>(0).into_owned();
+            let mut s: [f64; 3] = jp.singular_values().into();
+            s.sort_by(|p, q| q.total_cmp(p));
+            (s, -x.fixed_rows::<1>(3).into_owned())
+        }
+        _ => ([f64::INFINITY; 3], RowVector3::repeat(f64::INFINITY)),
+    }
+}
+
+/// The velocity amplification factors alone, largest first: [`kinetostatics`]'s, bit for bit,
+/// without its singular value decomposition of A (the workspace's constraint (iii) needs only
+/// these).
+pub fn amplification_factors(g: &ModuleGeometry, pose: &ModulePose, rho: &Sliders) -> [f64; 3] {
+    let (a, b, _) = scaled_jacobians(g, pose, rho);
+    velocity_map(&a, &b).0
+}
+
+pub fn kinetostatics(g: &ModuleGeometry, pose: &ModulePose, rho: &Sliders) -> Kinetostatics {
+    let (a, b, l) = scaled_jacobians(g, pose, rho);
     let det_a = a.determinant();
     let mut a_dimless: Matrix4<f64> = a;
     a_dimless.column_mut(3).scale_mut(1.0 / g.r_big2);
@@ -60,15 +94,7 @@ pub fn kinetostatics(g: &ModuleGeometry, pose: &ModulePose, rho: &Sliders) -> Ki
     };
     let v = rod_vectors(g, pose, rho);
     let serial_margin = (0..4).fold(f64::INFINITY, |m, i| m.min((v[i].z / l[i]).abs()));
-    let (amplification, rotation_rate) = match a.lu().solve(&b) {
-        Some(x) if x.iter().all(|e| e.is_finite()) => {
-            let jp: Matrix3<f64> = -x.fixed_rows::<3>(0).into_owned();
-            let mut s: Vec<f64> = jp.singular_values().iter().copied().collect();
-            s.sort_by(|p, q| q.total_cmp(p));
-            ([s[0], s[1], s[2]], -x.fixed_rows::<1>(3).into_owned())
-        }
-        _ => ([f64::INFINITY; 3], RowVector3::repeat(f64::INFINITY)),
-    };
+    let (amplification, rotation_rate) = velocity_map(&a, &b);
     Kinetostatics {
         det_a,
         parallel_margin,
@@ -121,6 +147,8 @@ mod tests {
         assert!(
             k.amplification[0] >= k.amplification[1] && k.amplification[1] >= k.amplification[2]
         );
+        // The workspace's shortcut gives the same factors, bit for bit.
+        assert_eq!(amplification_factors(&m.module, &w.pose, &rho), k.amplification);
         assert!(k.parallel_margin > 0.0 && k.parallel_margin <= 1.0);
         assert!(k.serial_margin > 0.0);
     }

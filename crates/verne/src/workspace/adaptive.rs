@@ -18,13 +18,11 @@
 //! inside and that plus the volume of the boundary cells of one step (corners disagreeing),
 //! under the same assumption; `error_bound_mm3` is that width.
 
-use std::collections::HashMap;
-
 use crate::par::*;
 use crate::spec::Machine;
 
 use super::grid::{Bounds, default_bounds, round_bounds};
-use super::{Outcome, WorkspaceOptions, classify};
+use super::{WorkspaceOptions, classify};
 
 /// The coarse step is the requested step times this, by default (a power of two).
 pub const DEFAULT_COARSE_FACTOR: usize = 8;
@@ -111,11 +109,10 @@ pub fn compute_adaptive(
         }
         *n_d = coarse as usize * s0 + 1;
     }
-    let key = |p: [usize; 3]| (p[0] + n[0] * (p[1] + n[1] * p[2])) as u64;
+    let lattice = Lattice { n };
     let point = |p: [usize; 3]| {
         b.min + nalgebra::Vector3::new(p[0] as f64, p[1] as f64, p[2] as f64) * step
     };
-    let mut known: HashMap<u64, Outcome> = HashMap::new();
     let mut summary = AdaptiveSummary {
         step,
         coarse_step: step * s0 as f64,
@@ -131,119 +128,64 @@ pub fn compute_adaptive(
         bbox: None,
         touches_bounds: false,
     };
-    let mut lo = [usize::MAX; 3];
-    let mut hi = [0usize; 3];
-    let mut inside_cells = 0u64;
-    let mut cells: Vec<[usize; 3]> = Vec::new();
+    let mut tally = Tally::empty();
+    let classify_point =
+        |key: u64| classify(m, opts, &point(lattice.at(key))).outcome.index() as u8;
+    // The cells of this level by their first corner's key, sorted; at first every coarse cell.
+    let mut cells: Vec<u64> = Vec::new();
     for k in (0..n[2] - 1).step_by(s0) {
         for j in (0..n[1] - 1).step_by(s0) {
             for i in (0..n[0] - 1).step_by(s0) {
-                cells.push([i, j, k]);
+                cells.push(lattice.key([i, j, k]));
             }
         }
     }
+    // The outcomes of the previous level's corners: a level keeps only its own corners, so
+    // memory follows the boundary, not every level's points.
+    let mut known = Outcomes::default();
     let mut s = s0;
-    // The points a cell owns along one axis: [c, c + s), and c + s too on the last cell.
-    let owned = |c: usize, s: usize, d: usize| if c + s == n[d] - 1 { s + 1 } else { s };
-    while !cells.is_empty() {
-        // Classify the corners not known yet, in parallel.
-        let mut needed: Vec<[usize; 3]> = Vec::new();
-        let mut seen = std::collections::HashSet::new();
-        for c in &cells {
-            for corner in corners(*c, s) {
-                let kk = key(corner);
-                if !known.contains_key(&kk) && seen.insert(kk) {
-                    needed.push(corner);
-                }
-            }
-        }
-        let classified: Vec<(u64, Outcome)> = needed
-            .par_iter()
-            .map(|p| (key(*p), classify(m, opts, &point(*p)).outcome))
-            .collect();
-        summary.classified += classified.len() as u64;
-        known.extend(classified);
+    loop {
+        let (corners_here, new_points) =
+            level_corners(&lattice, &cells, s, &[&known], &classify_point);
+        summary.classified += new_points;
+        known = corners_here;
         progress(summary.classified);
-        // Cells whose corners disagree, and (a guard against features thinner than a cell
-        // that reach out of the boundary) the cells next to them, are refined.
-        let inside = |p: &[usize; 3]| known[&key(*p)] == Outcome::Inside;
-        let agree = |c: &[usize; 3]| {
-            let first = inside(c);
-            corners(*c, s).iter().all(|p| inside(p) == first)
-        };
-        let mixed: std::collections::HashSet<[usize; 3]> =
-            cells.iter().filter(|c| !agree(c)).copied().collect();
-        let near_mixed = |c: &[usize; 3]| {
-            let step = s as isize;
-            (-1isize..=1).any(|dk| {
-                (-1isize..=1).any(|dj| {
-                    (-1isize..=1).any(|di| {
-                        let q = [
-                            c[0] as isize + di * step,
-                            c[1] as isize + dj * step,
-                            c[2] as isize + dk * step,
-                        ];
-                        q.iter().all(|v| *v >= 0)
-                            && mixed.contains(&[q[0] as usize, q[1] as usize, q[2] as usize])
-                    })
-                })
-            })
-        };
-        let mut next = Vec::new();
-        for c in &cells {
-            let first = known[&key(*c)];
-            let settled = s == 1 || !near_mixed(c);
-            if agree(c) && settled {
-                // An agreeing cell: its points take the corners' outcome.
-                let e = [owned(c[0], s, 0), owned(c[1], s, 1), owned(c[2], s, 2)];
-                let count = (e[0] * e[1] * e[2]) as u64;
-                summary.binding[first.index()] += count;
-                if first == Outcome::Inside {
-                    summary.inside_points += count;
-                    inside_cells += (s * s * s) as u64;
-                    for d in 0..3 {
-                        lo[d] = lo[d].min(c[d]);
-                        hi[d] = hi[d].max(c[d] + e[d] - 1);
-                    }
-                }
-            } else if s == 1 {
-                // A boundary cell of one step: its owned points, each as classified.
-                summary.boundary_cells += 1;
-                for dk in 0..owned(c[2], 1, 2) {
-                    for dj in 0..owned(c[1], 1, 1) {
-                        for di in 0..owned(c[0], 1, 0) {
-                            let p = [c[0] + di, c[1] + dj, c[2] + dk];
-                            let o = known[&key(p)];
-                            summary.binding[o.index()] += 1;
-                            if o == Outcome::Inside {
-                                summary.inside_points += 1;
-                                for d in 0..3 {
-                                    lo[d] = lo[d].min(p[d]);
-                                    hi[d] = hi[d].max(p[d]);
-                                }
-                            }
-                        }
-                    }
-                }
-            } else {
-                let h = s / 2;
-                for dk in [0, h] {
-                    for dj in [0, h] {
-                        for di in [0, h] {
-                            next.push([c[0] + di, c[1] + dj, c[2] + dk]);
-                        }
-                    }
-                }
-            }
+        let (level, parents) = decide_level(&lattice, &cells, s, &known);
+        tally = tally.merge(&level);
+        drop(cells);
+        if s == 2 {
+            // The last level, cells of one step, slab by slab: it is most of the points.
+            let (last, new_points) =
+                finest_level(&lattice, &parents, &known, &classify_point, &|c| {
+                    progress(summary.classified + c)
+                });
+            summary.classified += new_points;
+            tally = tally.merge(&last);
+            break;
         }
-        // The points of the finer cells' corners that are already known stay; the others of
-        // this level are no longer needed once no cell of the next level touches them.
-        cells = next;
-        s /= 2;
-        if s == 0 {
+        let h = s / 2;
+        // Eight children a parent, written in place (no growing vector), then sorted.
+        cells = vec![0u64; 8 * parents.len()];
+        cells
+            .par_chunks_mut(8)
+            .zip(parents.par_iter())
+            .for_each(|(out, &p)| {
+                for (o, c) in out.iter_mut().zip(children(&lattice, p, h)) {
+                    *o = c;
+                }
+            });
+        drop(parents);
+        cells.par_sort_unstable();
+        s = h;
+        if cells.is_empty() {
             break;
         }
     }
+    summary.inside_points = tally.inside_points;
+    summary.boundary_cells = tally.boundary_cells;
+    summary.binding = tally.binding;
+    let inside_cells = tally.inside_cells;
+    let (lo, hi) = (tally.lo, tally.hi);
     let h3 = step * step * step;
     summary.volume_mm3 = summary.inside_points as f64 * h3;
     summary.volume_lo_mm3 = inside_cells as f64 * h3;
@@ -256,6 +198,288 @@ pub fn compute_adaptive(
         summary.touches_bounds = (0..3).any(|d| lo[d] == 0 || hi[d] == n[d] - 1);
     }
     Ok(summary)
+}
+
+/// Cells of one step added up together in the last level (a slab: whole z planes of them).
+const SLAB_CELLS: usize = 1 << 17;
+
+/// Cells whose corners are listed together (their repeats dropped) before the lists are joined.
+const CORNER_RUN: usize = 1 << 17;
+
+/// Outcome index of an inside point ([`super::Outcome::index`]).
+const INSIDE: u8 = 0;
+
+/// The extended fine lattice: `n` points along each axis, a point's key `i + n0 (j + n1 k)`
+/// (sorting keys sorts by z, then y, then x).
+#[derive(Clone, Copy)]
+struct Lattice {
+    n: [usize; 3],
+}
+
+impl Lattice {
+    fn key(&self, p: [usize; 3]) -> u64 {
+        (p[0] + self.n[0] * (p[1] + self.n[1] * p[2])) as u64
+    }
+
+    fn at(&self, key: u64) -> [usize; 3] {
+        let k = key as usize;
+        [
+            k % self.n[0],
+            (k / self.n[0]) % self.n[1],
+            k / (self.n[0] * self.n[1]),
+        ]
+    }
+
+    /// The points a cell of size `s` at `c` owns along axis `d`: [c, c + s), and c + s too on
+    /// the last cell.
+    fn owned(&self, c: usize, s: usize, d: usize) -> usize {
+        if c + s == self.n[d] - 1 { s + 1 } else { s }
+    }
+}
+
+/// The outcomes of one level's points: sorted keys and [`super::Outcome::index`] values.
+#[derive(Default)]
+struct Outcomes {
+    keys: Vec<u64>,
+    outcome: Vec<u8>,
+}
+
+impl Outcomes {
+    fn get(&self, key: u64) -> Option<u8> {
+        self.keys.binary_search(&key).ok().map(|i| self.outcome[i])
+    }
+
+    /// The outcome of a corner of this level (every corner was classified or carried over).
+    fn at(&self, key: u64) -> u8 {
+        self.get(key).unwrap_or(u8::MAX)
+    }
+}
+
+/// What the leaf cells add up to: counts, and the box of the inside points (lattice indices).
+#[derive(Clone, Copy)]
+struct Tally {
+    inside_points: u64,
+    inside_cells: u64,
+    boundary_cells: u64,
+    binding: [u64; 7],
+    lo: [usize; 3],
+    hi: [usize; 3],
+}
+
+impl Tally {
+    fn empty() -> Tally {
+        Tally {
+            inside_points: 0,
+            inside_cells: 0,
+            boundary_cells: 0,
+            binding: [0; 7],
+            lo: [usize::MAX; 3],
+            hi: [0; 3],
+        }
+    }
+
+    fn include(&mut self, lo: [usize; 3], hi: [usize; 3]) {
+        for d in 0..3 {
+            self.lo[d] = self.lo[d].min(lo[d]);
+            self.hi[d] = self.hi[d].max(hi[d]);
+        }
+    }
+
+    /// A cell of size `s` whose corners agree on `first`: its points take that outcome.
+    fn agreeing_cell(&mut self, lattice: &Lattice, c: [usize; 3], s: usize, first: u8) {
+        let e = [0, 1, 2].map(|d| lattice.owned(c[d], s, d));
+        let count = (e[0] * e[1] * e[2]) as u64;
+        self.binding[first as usize] += count;
+        if first == INSIDE {
+            self.inside_points += count;
+            self.inside_cells += (s * s * s) as u64;
+            self.include(c, [c[0] + e[0] - 1, c[1] + e[1] - 1, c[2] + e[2] - 1]);
+        }
+    }
+
+    /// A cell of one step: agreeing, or a boundary cell whose owned points count each as
+    /// classified. `known` holds its corners.
+    fn finest_cell(&mut self, lattice: &Lattice, c: [usize; 3], known: &Outcomes) {
+        let first = known.at(lattice.key(c));
+        let agree = corners(c, 1)
+            .iter()
+            .all(|p| (known.at(lattice.key(*p)) == INSIDE) == (first == INSIDE));
+        if agree {
+            self.agreeing_cell(lattice, c, 1, first);
+            return;
+        }
+        self.boundary_cells += 1;
+        for dk in 0..lattice.owned(c[2], 1, 2) {
+            for dj in 0..lattice.owned(c[1], 1, 1) {
+                for di in 0..lattice.owned(c[0], 1, 0) {
+                    let p = [c[0] + di, c[1] + dj, c[2] + dk];
+                    let o = known.at(lattice.key(p));
+                    self.binding[o as usize] += 1;
+                    if o == INSIDE {
+                        self.inside_points += 1;
+                        self.include(p, p);
+                    }
+                }
+            }
+        }
+    }
+
+    fn merge(mut self, o: &Tally) -> Tally {
+        self.inside_points += o.inside_points;
+        self.inside_cells += o.inside_cells;
+        self.boundary_cells += o.boundary_cells;
+        for (a, b) in self.binding.iter_mut().zip(o.binding) {
+            *a += b;
+        }
+        self.include(o.lo, o.hi);
+        self
+    }
+}
+
+/// The eight cells of size `h` that halve the cell of size `2 h` at `key`.
+fn children(lattice: &Lattice, key: u64, h: usize) -> impl Iterator<Item = u64> + '_ {
+    let c = lattice.at(key);
+    (0..8).map(move |k| {
+        lattice.key([
+            c[0] + (k & 1) * h,
+            c[1] + (k >> 1 & 1) * h,
+            c[2] + (k >> 2 & 1) * h,
+        ])
+    })
+}
+
+/// The corners of `cells` (size `s`), each once, with their outcomes: taken from `sources`
+/// where one knows it, classified (in parallel) otherwise; and how many were classified.
+fn level_corners(
+    lattice: &Lattice,
+    cells: &[u64],
+    s: usize,
+    sources: &[&Outcomes],
+    classify_point: &(dyn Fn(u64) -> u8 + Sync),
+) -> (Outcomes, u64) {
+    // Neighbouring cells share corners: each run of cells (consecutive keys) drops its repeats
+    // before the runs are joined, so the list never holds eight per cell.
+    let mut keys: Vec<u64> = cells
+        .par_chunks(CORNER_RUN)
+        .flat_map_iter(|run| {
+            let mut k: Vec<u64> = run
+                .iter()
+                .flat_map(|&c| corners(lattice.at(c), s).map(|p| lattice.key(p)))
+                .collect();
+            k.sort_unstable();
+            k.dedup();
+            k
+        })
+        .collect();
+    keys.par_sort_unstable();
+    keys.dedup();
+    let looked_up = |k: u64| sources.iter().find_map(|o| o.get(k));
+    let outcome: Vec<u8> = keys
+        .par_iter()
+        .map(|&k| looked_up(k).unwrap_or_else(|| classify_point(k)))
+        .collect();
+    let new_points = keys.par_iter().filter(|&&k| looked_up(k).is_none()).count();
+    (Outcomes { keys, outcome }, new_points as u64)
+}
+
+/// The leaf cells of one level (size `s` >= 2) added up, and the cells to halve: those whose
+/// corners disagree and, a guard against features thinner than a cell that reach out of the
+/// boundary, the cells next to them. `known` holds every corner of `cells`.
+fn decide_level(lattice: &Lattice, cells: &[u64], s: usize, known: &Outcomes) -> (Tally, Vec<u64>) {
+    let n = lattice.n;
+    let inside = |p: [usize; 3]| known.at(lattice.key(p)) == INSIDE;
+    let agree = |c: [usize; 3]| {
+        let first = inside(c);
+        corners(c, s).iter().all(|p| inside(*p) == first)
+    };
+    let mixed: Vec<u64> = cells
+        .par_iter()
+        .filter(|&&c| !agree(lattice.at(c)))
+        .copied()
+        .collect();
+    let near_mixed = |c: [usize; 3]| {
+        let step = s as isize;
+        (-1isize..=1).any(|dk| {
+            (-1isize..=1).any(|dj| {
+                (-1isize..=1).any(|di| {
+                    let q = [
+                        c[0] as isize + di * step,
+                        c[1] as isize + dj * step,
+                        c[2] as isize + dk * step,
+                    ];
+                    (0..3).all(|d| q[d] >= 0 && (q[d] as usize) < n[d])
+                        && mixed
+                            .binary_search(&lattice.key(q.map(|v| v as usize)))
+                            .is_ok()
+                })
+            })
+        })
+    };
+    cells
+        .par_iter()
+        .fold(
+            || (Tally::empty(), Vec::new()),
+            |(mut t, mut halve), &key| {
+                let c = lattice.at(key);
+                if agree(c) && !near_mixed(c) {
+                    t.agreeing_cell(lattice, c, s, known.at(key));
+                } else {
+                    halve.push(key);
+                }
+                (t, halve)
+            },
+        )
+        .reduce(
+            || (Tally::empty(), Vec::new()),
+            |(a, mut ha), (b, hb)| {
+                ha.extend(hb);
+                (a.merge(&b), ha)
+            },
+        )
+}
+
+/// The last level: the cells of one step that halve `parents` (cells of two steps, sorted),
+/// added up slab by slab along z (so that only one slab's points are held), each slab's cells
+/// in parallel. A corner's outcome comes from `known` (the level above), from the previous slab
+/// (the plane two slabs share), or is classified. Returns the tally and the points classified.
+fn finest_level(
+    lattice: &Lattice,
+    parents: &[u64],
+    known: &Outcomes,
+    classify_point: &(dyn Fn(u64) -> u8 + Sync),
+    progress: &dyn Fn(u64),
+) -> (Tally, u64) {
+    let plane = (lattice.n[0] * lattice.n[1]) as u64;
+    let mut tally = Tally::empty();
+    let mut classified = 0u64;
+    let mut previous = Outcomes::default();
+    let mut start = 0;
+    while start < parents.len() {
+        // Whole planes of parents (z of the parents' first corners), at least SLAB_CELLS.
+        let mut end = (start + SLAB_CELLS).min(parents.len());
+        while end < parents.len() && parents[end] / plane == parents[end - 1] / plane {
+            end += 1;
+        }
+        let cells: Vec<u64> = parents[start..end]
+            .par_iter()
+            .flat_map_iter(|&p| children(lattice, p, 1))
+            .collect();
+        let (here, new_points) =
+            level_corners(lattice, &cells, 1, &[known, &previous], classify_point);
+        classified += new_points;
+        progress(classified);
+        let slab = cells
+            .par_iter()
+            .fold(Tally::empty, |mut t, &key| {
+                t.finest_cell(lattice, lattice.at(key), &here);
+                t
+            })
+            .reduce(Tally::empty, |a, b| a.merge(&b));
+        tally = tally.merge(&slab);
+        previous = here;
+        start = end;
+    }
+    (tally, classified)
 }
 
 /// The eight corners of the cell of size `s` at `c`.

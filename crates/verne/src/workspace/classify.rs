@@ -8,7 +8,7 @@ use crate::math::trig::{MAX_TRIG_ROOTS, Trig};
 use crate::parallel_module::branches::{Reason, WORKING_CONFIG};
 use crate::parallel_module::equations::ModulePose;
 use crate::parallel_module::ik::{self, IkBranch, wrap_angle};
-use crate::parallel_module::kinetostatics::kinetostatics;
+use crate::parallel_module::kinetostatics::amplification_factors;
 use crate::spec::{Machine, ModuleGeometry, TableGeometry};
 use crate::tolerance::LIMIT_SLACK;
 
@@ -152,8 +152,11 @@ fn branch_fails(
         p: *p,
         alpha: b.alpha,
     };
-    let k = kinetostatics(&m.module, &pose, &b.rho);
-    if !k.amplification_within(lambda[0], lambda[1]) {
+    let amplification = amplification_factors(&m.module, &pose, &b.rho);
+    if !amplification
+        .iter()
+        .all(|&l| l >= lambda[0] && l <= lambda[1])
+    {
         f.add(Constraint::Singularity);
     }
     if b.verdict.has(Reason::Rho1Stroke)
@@ -168,7 +171,7 @@ fn branch_fails(
     {
         f.add(Constraint::Theta1Range);
     }
-    (f, k.amplification)
+    (f, amplification)
 }
 
 /// Classifies one grid point.
