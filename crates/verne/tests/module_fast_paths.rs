@@ -240,6 +240,8 @@ fn tracked_agrees(m: &Machine, path: &[Sliders]) -> (usize, u64) {
             );
         }
     }
+    // Every row is answered once, by tracking or by the complete solution.
+    assert_eq!(tracker.tracked + tracker.solved, path.len() as u64);
     (present, tracker.tracked)
 }
 

@@ -222,4 +222,104 @@ mod tests {
             Ok(AxisAngles::NearRotary { .. })
         ));
     }
+
+    #[test]
+    fn a_near_unit_axis_is_normalised() {
+        for v in [
+            Vector3::new(0.0, 0.6, 0.8) * 1.0009,
+            Vector3::new(0.3, -0.4, 0.5).normalize() * 0.9991,
+        ] {
+            let u = unit_axis(&v).unwrap();
+            assert!((u.norm() - 1.0).abs() < 1e-15, "{u:?}");
+            assert!((u - v.normalize()).amax() < 1e-15);
+        }
+    }
+
+    #[test]
+    fn the_cone_is_open() {
+        // An axis exactly at ROTARY_SINGULAR_CONE_RAD from the pole is outside the cone: searched
+        // ulp by ulp in x for (x, 0, 1), whose tilt is computed as axis_angles does. (At the
+        // other pole PI - phi1 is a multiple of ulp(PI), which the cone is not: no axis lies
+        // exactly on that edge.)
+        let tilt = |v: &Vector3<f64>| {
+            let a = unit_axis(v).unwrap();
+            a.x.hypot(a.y).atan2(a.z)
+        };
+        let mut found = 0;
+        let mut x = ROTARY_SINGULAR_CONE_RAD.tan();
+        for _ in 0..64 {
+            x = x.next_down();
+        }
+        for _ in 0..128 {
+            let v = Vector3::new(x, 0.0, 1.0);
+            let phi1 = tilt(&v);
+            if phi1 == ROTARY_SINGULAR_CONE_RAD {
+                found += 1;
+                assert!(
+                    matches!(axis_angles(&v), Ok(AxisAngles::Regular(_))),
+                    "phi1 {phi1} on the cone's edge"
+                );
+            }
+            x = x.next_up();
+        }
+        assert!(found >= 1, "no axis on the cone's edge found");
+    }
+
+    #[test]
+    fn phi1_at_an_axis_own_azimuth_is_its_tilt() {
+        for &(p1, p2) in &[(0.3, 0.0), (-0.7, 2.0), (1.2, -3.0), (2.5, 1.0)] {
+            let a = tool_axis(p1, p2);
+            assert!((phi1_at(&a, p2) - p1).abs() < 1e-14);
+            // The other azimuth of the same plane: the opposite tilt.
+            assert!((phi1_at(&a, p2 + PI) + p1).abs() < 1e-14);
+        }
+    }
+
+    /// |d phi1| + |d phi2| of a move, phi2 the shorter way round.
+    fn table_move(a: (f64, f64), b: (f64, f64)) -> f64 {
+        (b.0 - a.0).abs() + wrap_angle(b.1 - a.1).abs()
+    }
+
+    #[test]
+    fn a_move_takes_the_smallest_table_move() {
+        // Every pair of orientation solutions, brute force, against move_angles' choice.
+        let mut r = crate::math::test_rng::lcg(11);
+        let mut axis = || tool_axis(0.01 + 1.49 * r(), PI * (2.0 * r() - 1.0));
+        for _ in 0..2000 {
+            let (a, b) = (axis(), axis());
+            let [ea, eb] = move_angles(&a, None, &b, None);
+            assert!((tool_axis(ea.0, ea.1) - a).amax() < 1e-14);
+            assert!((tool_axis(eb.0, eb.1) - b).amax() < 1e-14);
+            let sols = |v: &Vector3<f64>| match axis_angles(v).unwrap() {
+                AxisAngles::Regular(s) => s.map(|s| (s.phi1, s.phi2)),
+                AxisAngles::NearRotary { .. } => unreachable!("tilted axes"),
+            };
+            let best = sols(&a)
+                .iter()
+                .flat_map(|x| sols(&b).map(|y| table_move(*x, y)))
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                (table_move(ea, eb) - best).abs() < 1e-12,
+                "{ea:?} {eb:?} vs {best}"
+            );
+            // phi2 is carried the shorter way round, unwrapped from the start.
+            assert!((eb.1 - ea.1).abs() <= PI + 1e-12);
+        }
+    }
+
+    #[test]
+    fn a_tie_keeps_the_first_solution_at_the_start() {
+        // A tilt that changes sign in one plane: through the normal from solution 1 (phi1 > 0)
+        // or from solution 2, the same table move; the first is kept.
+        let (a, b) = (tool_axis(0.2, 0.0), tool_axis(-0.2, 0.0));
+        let [ea, eb] = move_angles(&a, None, &b, None);
+        assert!((ea.0 - 0.2).abs() < 1e-15 && ea.1.abs() < 1e-15, "{ea:?}");
+        assert!((eb.0 + 0.2).abs() < 1e-15 && eb.1.abs() < 1e-15, "{eb:?}");
+        // Stated angles are used as stated.
+        let stated = [(0.1, 3.0), (-0.1, -3.0)];
+        assert_eq!(
+            move_angles(&a, Some(stated[0]), &b, Some(stated[1])),
+            stated
+        );
+    }
 }

@@ -148,7 +148,10 @@ mod tests {
             k.amplification[0] >= k.amplification[1] && k.amplification[1] >= k.amplification[2]
         );
         // The workspace's shortcut gives the same factors, bit for bit.
-        assert_eq!(amplification_factors(&m.module, &w.pose, &rho), k.amplification);
+        assert_eq!(
+            amplification_factors(&m.module, &w.pose, &rho),
+            k.amplification
+        );
         assert!(k.parallel_margin > 0.0 && k.parallel_margin <= 1.0);
         assert!(k.serial_margin > 0.0);
     }
