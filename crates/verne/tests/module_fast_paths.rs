@@ -214,7 +214,7 @@ fn fk_solve_builds_agree() {
 
 /// Compares the tracked working mode with the complete solver's on every row of a path;
 /// returns (rows with a working mode, rows answered by tracking).
-fn tracked_agrees(m: &Machine, path: &[Sliders]) -> (usize, u64) {
+fn tracked_agrees(m: &Machine, path: &[Sliders]) -> (usize, u64, u64) {
     let mut tracker = FkTracker::new(m);
     let mut modes = FkModes::new();
     let mut present = 0;
@@ -242,7 +242,7 @@ fn tracked_agrees(m: &Machine, path: &[Sliders]) -> (usize, u64) {
     }
     // Every row is answered once, by tracking or by the complete solution.
     assert_eq!(tracker.tracked + tracker.solved, path.len() as u64);
-    (present, tracker.tracked)
+    (present, tracker.tracked, tracker.chord_steps)
 }
 
 /// Joints of the working branch along a helix of P (the path of the benchmarks).
@@ -265,10 +265,13 @@ fn helix_joints(m: &Machine, rows: usize) -> Vec<Sliders> {
 fn tracked_fk_matches_the_complete_solver_along_a_helix() {
     let m = Machine::default_verne();
     let path = helix_joints(&m, 4096);
-    let (present, tracked) = tracked_agrees(&m, &path);
+    let (present, tracked, steps) = tracked_agrees(&m, &path);
     assert_eq!(present, path.len());
     // Only the first row needs the complete solution.
     assert_eq!(tracked as usize, path.len() - 1);
+    // The predictor (the pose extrapolated from the last two rows) leaves about three chord
+    // steps a row: two to converge, one below rounding.
+    assert!(steps <= 3 * tracked + tracked / 10, "{steps} chord steps for {tracked} rows");
 }
 
 /// Along rays in joint space through the place where the working mode ends (it meets another
@@ -304,7 +307,7 @@ fn tracked_fk_matches_the_complete_solver_through_branch_switches() {
                 .collect();
             let back: Vec<Sliders> = forward.iter().rev().copied().collect();
             for path in [forward, back] {
-                let (present, t) = tracked_agrees(&m, &path);
+                let (present, t, _) = tracked_agrees(&m, &path);
                 rows_present += present;
                 tracked += t as usize;
             }

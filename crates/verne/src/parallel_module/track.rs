@@ -46,6 +46,8 @@ pub struct FkTracker<'m> {
     /// Rows answered by tracking and by the complete solution.
     pub tracked: u64,
     pub solved: u64,
+    /// Chord steps taken, tracked or not (the predictor's worth: fewer steps a row).
+    pub chord_steps: u64,
 }
 
 impl<'m> FkTracker<'m> {
@@ -65,6 +67,7 @@ impl<'m> FkTracker<'m> {
             before_last: None,
             tracked: 0,
             solved: 0,
+            chord_steps: 0,
         }
     }
 
@@ -102,6 +105,7 @@ impl<'m> FkTracker<'m> {
         };
         let mut converged = false;
         for _ in 0..MAX_CHORD_STEPS {
+            self.chord_steps += 1;
             let step = inv_prev * residuals(g, &pose, rho);
             if !step.iter().all(|v| v.is_finite()) {
                 return None;
