@@ -22,11 +22,15 @@ fn scratch(test: &str) -> PathBuf {
 
 /// The program's joints resampled at 1 ms, as halstreamer plays them.
 fn stream(dir: &Path) -> Vec<String> {
+    stream_of(dir, PROGRAM)
+}
+
+fn stream_of(dir: &Path, program: &str) -> Vec<String> {
     let file = dir.join("stream.hal");
     let out = run(
         &[
             "ik",
-            PROGRAM,
+            program,
             "--format",
             "halstreamer",
             "--period",
@@ -48,6 +52,16 @@ fn stream(dir: &Path) -> Vec<String> {
 
 /// Runs verify on `lines` written to `name`; returns (exit code, report rows, stderr).
 fn verify(dir: &Path, name: &str, lines: &[String], extra: &[&str]) -> (i32, Vec<String>, String) {
+    verify_against(dir, name, lines, PROGRAM, extra)
+}
+
+fn verify_against(
+    dir: &Path,
+    name: &str,
+    lines: &[String],
+    program: &str,
+    extra: &[&str],
+) -> (i32, Vec<String>, String) {
     let file = dir.join(name);
     fs::write(&file, lines.join("\n") + "\n").unwrap();
     let report = dir.join(format!("{name}.report.csv"));
@@ -59,7 +73,7 @@ fn verify(dir: &Path, name: &str, lines: &[String], extra: &[&str]) -> (i32, Vec
         "--period",
         "1ms",
         "--path",
-        PROGRAM,
+        program,
         "--report",
         report.to_str().unwrap(),
     ];
@@ -118,6 +132,37 @@ fn a_stream_follows_its_program_and_a_perturbed_sample_is_found_at_its_line() {
     let tips: Vec<&String> = rows.iter().filter(|r| r.contains(",tip_error,")).collect();
     assert_eq!(tips.len(), 1, "{rows:?}");
     assert!(tips[0].starts_with("20000,"), "{}", tips[0]);
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_tool_centre_program_streams_its_angle_words() {
+    // data/example-tcp.ngc gives the orientation as A C words: its last rapid, A10 C30 to A0 C0,
+    // turns C as it tilts back to the table normal. The stream interpolates the words as
+    // LinuxCNC does (it took them from the axes before, keeping C: 0.47 deg off there), and the
+    // vertical rows take theta2 = -C = 0 as programmed.
+    let dir = scratch("tcp");
+    let lines = stream_of(&dir, "data/example-tcp.ngc");
+    let (code, rows, err) = verify_against(&dir, "tcp.hal", &lines, "data/example-tcp.ngc", &[]);
+    assert!(code <= 1, "{err}");
+    assert!(
+        checks_besides_acceleration(&rows).is_empty(),
+        "{rows:?}\n{err}"
+    );
+    for check in ["tip_error", "axis_error"] {
+        let line = err.lines().find(|l| l.starts_with(check)).unwrap();
+        let worst: f64 = line.split_whitespace().nth(2).unwrap().parse().unwrap();
+        assert!(worst < 1e-6, "{line}");
+    }
+    let theta2: Vec<f64> = lines
+        .iter()
+        .map(|l| l.split_whitespace().nth(4).unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(
+        theta2[0], 0.0,
+        "the program starts at C0 on the table normal"
+    );
+    assert_eq!(*theta2.last().unwrap(), 0.0, "and ends there");
     let _ = fs::remove_dir_all(&dir);
 }
 

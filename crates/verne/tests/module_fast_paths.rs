@@ -271,7 +271,10 @@ fn tracked_fk_matches_the_complete_solver_along_a_helix() {
     assert_eq!(tracked as usize, path.len() - 1);
     // The predictor (the pose extrapolated from the last two rows) leaves about three chord
     // steps a row: two to converge, one below rounding.
-    assert!(steps <= 3 * tracked + tracked / 10, "{steps} chord steps for {tracked} rows");
+    assert!(
+        steps <= 3 * tracked + tracked / 10,
+        "{steps} chord steps for {tracked} rows"
+    );
 }
 
 /// Along rays in joint space through the place where the working mode ends (it meets another

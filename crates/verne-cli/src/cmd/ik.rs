@@ -16,7 +16,7 @@ use crate::cli::{IkArgs, OutputFormat, Prefer};
 use crate::input::as_csv::AsCsv;
 use crate::input::cl::{ClAsCsv, ClRows, PathInput, open_path_input, report_summary};
 use crate::input::gcode::{TcpAsCsv, TcpRows};
-use crate::input::resample::Resampler;
+use crate::input::resample::{CsvPoses, Resampler};
 
 pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
     let machine = match load_mechanism(args.common.machine.as_deref())? {
@@ -65,18 +65,25 @@ pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
     crate::arg_values::spatial(&args.pose, "--pose", "XP,YP,ZP").map_err(VerneError::Usage)?;
     let (source, summaries) = open_source(args, &machine)?;
     (cl_summary, gcode_summary) = summaries;
-    let source = match args.period {
-        Some(period) => {
+    let source = match (args.period, source) {
+        // A program's poses straight from its reader, angle words and all.
+        (Some(period), Source::Program(rows, name)) => {
+            let rows = Resampler::new(Box::new(rows), period, args.rapid, args.common.radians);
+            CsvSource::from_reader(Box::new(AsCsv::new(rows)), &name)?.with_line_column("line")
+        }
+        (None, program @ Source::Program(..)) => program.into_csv()?,
+        (Some(period), Source::Csv(source)) => {
             if source.column("xp").is_some() && source.column("x").is_none() {
                 return Err(VerneError::Usage(
                     "--period resamples a toolpath of tool poses (x,y,z with i,j,k or phi1,phi2), not platform points".into(),
                 ));
             }
             let name = source.name().to_string();
-            let rows = Resampler::new(source, period, args.rapid, args.common.radians)?;
+            let poses = CsvPoses::new(source, args.common.radians)?;
+            let rows = Resampler::new(Box::new(poses), period, args.rapid, args.common.radians);
             CsvSource::from_reader(Box::new(AsCsv::new(rows)), &name)?.with_line_column("line")
         }
-        None => source,
+        (None, Source::Csv(source)) => source,
     };
     let offset = args.part.offset();
     let has = |c: &str| source.column(c).is_some();
@@ -167,30 +174,53 @@ type Summaries = (
 
 /// The rows of `verne ik` as CSV: inline poses, a CSV, a CL file or a G-code program (with the
 /// reader's summary, shared, to print at the end).
-fn open_source(args: &IkArgs, machine: &Machine) -> Result<(CsvSource, Summaries), VerneError> {
+/// The input of `verne ik`: rows as CSV, or a tool-centre program's poses (read as CSV text
+/// by the row engine, or straight from the reader by `--period`).
+enum Source {
+    Csv(CsvSource),
+    Program(TcpRows, String),
+}
+
+impl Source {
+    /// The input as CSV rows (a program's poses as `TcpRows` writes them).
+    fn into_csv(self) -> Result<CsvSource, VerneError> {
+        match self {
+            Source::Csv(src) => Ok(src),
+            Source::Program(rows, name) => Ok(CsvSource::from_reader(
+                Box::new(TcpAsCsv::new(rows)),
+                &name,
+            )?
+            .with_line_column("line")),
+        }
+    }
+}
+
+fn open_source(args: &IkArgs, machine: &Machine) -> Result<(Source, Summaries), VerneError> {
     if !args.pose.is_empty() {
         let rows: Vec<Vec<f64>> = args.pose.iter().map(|p| p.to_vec()).collect();
-        return Ok((inline_source("xp,yp,zp", &rows)?, (None, None)));
+        return Ok((Source::Csv(inline_source("xp,yp,zp", &rows)?), (None, None)));
     }
     if !args.tool.is_empty() {
         let rows: Vec<Vec<f64>> = args.tool.iter().map(|p| p.to_vec()).collect();
-        return Ok((inline_source("x,y,z,i,j,k", &rows)?, (None, None)));
+        return Ok((
+            Source::Csv(inline_source("x,y,z,i,j,k", &rows)?),
+            (None, None),
+        ));
     }
     let options = args.part.read_options(&machine.gcode);
     Ok(
         match open_path_input(args.input.as_deref(), args.input_format, &options)? {
-            PathInput::Csv(src) => (src, (None, None)),
+            PathInput::Csv(src) => (Source::Csv(src), (None, None)),
             PathInput::Gcode(reader, name) => {
                 let rows = TcpRows::new(*reader, &name, &machine.gcode);
                 let summary = Some((rows.summary(), name.clone()));
-                let src = CsvSource::from_reader(Box::new(TcpAsCsv::new(rows)), &name)?;
-                (src.with_line_column("line"), (None, summary))
+                (Source::Program(rows, name), (None, summary))
             }
             PathInput::Cl(reader, name) => {
                 let rows = ClRows::new(*reader);
                 let summary = Some((rows.summary(), name.clone()));
                 let src = CsvSource::from_reader(Box::new(ClAsCsv::new(rows)), &name)?;
-                (src.with_line_column("line"), (summary, None))
+                (Source::Csv(src.with_line_column("line")), (summary, None))
             }
         },
     )
@@ -215,7 +245,7 @@ fn prescan_theta2(
     if !rereadable {
         return Ok(None);
     }
-    let (mut src, _) = open_source(args, machine)?;
+    let mut src = open_source(args, machine)?.0.into_csv()?;
     let col = |c: &str| src.column(c);
     let (Some(x), Some(y), Some(z)) = (col("x"), col("y"), col("z")) else {
         return Ok(None);

@@ -21,6 +21,7 @@ use verne_gcode::{AXES, Axis, GcodeError, Motion, Options, Reader, Row, Summary}
 
 use crate::error::VerneError;
 use crate::input::as_csv::{AsCsv, CsvRows, invalid_data};
+use crate::input::resample::{PathPose, PoseStream};
 
 /// A G-code reader over a boxed input, as the CLI reads files and stdin alike.
 pub type GcodeReader = Reader<Box<dyn BufRead + Send>>;
@@ -198,29 +199,9 @@ impl CsvRows for TcpRows {
     }
 
     fn next_row(&mut self, buf: &mut Vec<u8>) -> std::io::Result<bool> {
-        match self.next_pose() {
-            None => {
-                if self.reader.summary().rows == 0 {
-                    return Err(invalid_data(
-                        "no move (G0, G1, G2, G3 or a cycle): no tool pose to convert".into(),
-                    ));
-                }
-                Ok(false)
-            }
-            Some(Err(e)) => Err(invalid_data(match e {
-                // The CSV view names the file itself.
-                VerneError::Input {
-                    line: Some(line),
-                    column,
-                    message,
-                    ..
-                } => match column {
-                    Some(c) => format!("line {line}, column {c}: {message}"),
-                    None => format!("line {line}: {message}"),
-                },
-                other => other.to_string(),
-            })),
-            Some(Ok(p)) => {
+        match self.next_pose_or_end()? {
+            None => Ok(false),
+            Some(p) => {
                 let r = &p.row;
                 write!(buf, "{},", r.line)?;
                 if let Some(n) = r.n {
@@ -248,6 +229,68 @@ impl CsvRows for TcpRows {
                 Ok(true)
             }
         }
+    }
+}
+
+impl TcpRows {
+    /// The next pose, `None` at the end; an error as the CSV view reports it (the view names
+    /// the file itself), and a program without a move is an error.
+    fn next_pose_or_end(&mut self) -> std::io::Result<Option<TcpPose>> {
+        match self.next_pose() {
+            None => {
+                if self.reader.summary().rows == 0 {
+                    return Err(invalid_data(
+                        "no move (G0, G1, G2, G3 or a cycle): no tool pose to convert".into(),
+                    ));
+                }
+                Ok(None)
+            }
+            Some(Err(e)) => Err(invalid_data(match e {
+                VerneError::Input {
+                    line: Some(line),
+                    column,
+                    message,
+                    ..
+                } => match column {
+                    Some(c) => format!("line {line}, column {c}: {message}"),
+                    None => format!("line {line}: {message}"),
+                },
+                other => other.to_string(),
+            })),
+            Some(Ok(p)) => Ok(Some(p)),
+        }
+    }
+}
+
+/// A tool-centre program read by the `--period` resampler directly: the program's angle
+/// words go with each pose, so the stream turns the rotary axes as the controller does.
+impl PoseStream for TcpRows {
+    fn states_angles(&self) -> bool {
+        matches!(self.orientation, GcodeOrientation::Angles { .. })
+    }
+
+    fn next_pose(&mut self) -> std::io::Result<Option<PathPose>> {
+        let Some(p) = self.next_pose_or_end()? else {
+            return Ok(None);
+        };
+        let r = &p.row;
+        let axis = Vector3::from(p.axis);
+        let n = axis.norm();
+        if n.is_nan() || n <= 1e-12 {
+            return Err(invalid_data(format!(
+                "line {}: the tool axis is zero",
+                r.line
+            )));
+        }
+        Ok(Some(PathPose {
+            tip: Vector3::from(p.tip),
+            axis: axis / n,
+            angles: p.angles,
+            line: r.line.to_string(),
+            rapid: r.motion == Motion::Rapid,
+            feed_mm_min: r.feed_per_min.filter(|_| r.motion == Motion::Feed),
+            dt: r.duration_s,
+        }))
     }
 }
 

@@ -32,8 +32,38 @@ enum Orientation {
 struct Pose {
     tip: Vector3<f64>,
     axis: Vector3<f64>,
-    /// The tool angles (rad) when the input states them (phi1,phi2 columns).
+    /// The tool angles (rad) when the input states them (phi1,phi2 columns, a program's angle
+    /// words).
     angles: Option<(f64, f64)>,
+}
+
+/// One pose of a toolpath and the move to it, as the resampler reads it.
+pub struct PathPose {
+    pub tip: Vector3<f64>,
+    /// Unit tool axis.
+    pub axis: Vector3<f64>,
+    /// The tool angles (phi1, phi2) (rad) when the input states them: the controller
+    /// interpolates these.
+    pub angles: Option<(f64, f64)>,
+    /// The input's line, for the samples' `line` column and messages.
+    pub line: String,
+    /// A rapid move (timed at `--rapid`).
+    pub rapid: bool,
+    /// The move's feed (mm/min), when the input gives one.
+    pub feed_mm_min: Option<f64>,
+    /// The move's time (s) when the input states it (a program's feed rule, `G93`).
+    pub dt: Option<f64>,
+}
+
+/// A toolpath read pose by pose: a CSV ([`CsvPoses`]) or a tool-centre program's reader
+/// directly (`input::gcode::TcpRows`, whose angle words are kept).
+pub trait PoseStream: Send {
+    /// The next pose, or `None` at the end; an error names the line.
+    fn next_pose(&mut self) -> io::Result<Option<PathPose>>;
+    /// Whether every pose states its tool angles (phi1,phi2 columns, a program's angle words):
+    /// the samples then carry the interpolated angles, which the inverse kinematics follows as
+    /// the controller does (theta2 = -phi2 even on the table normal), instead of the axis.
+    fn states_angles(&self) -> bool;
 }
 
 /// The move being sampled: from `a` at `t0` to `b` at `t1` (s).
@@ -45,9 +75,9 @@ struct Move {
     line: String,
 }
 
-/// A CSV toolpath (x,y,z with i,j,k or phi1,phi2, and feed, motion, line, dt when present)
-/// resampled at a period; rows `line,t,x,y,z,i,j,k`.
-pub struct Resampler {
+/// The poses of a CSV toolpath (x,y,z with i,j,k or phi1,phi2, and feed, motion, line, dt when
+/// present).
+pub struct CsvPoses {
     src: CsvSource,
     line: Option<usize>,
     motion: Option<usize>,
@@ -55,24 +85,12 @@ pub struct Resampler {
     dt: Option<usize>,
     xyz: [usize; 3],
     orientation: Orientation,
-    period: f64,
-    rapid_mm_min: Option<f64>,
     rec: ByteRecord,
-    current: Option<Move>,
-    /// Index of the next sample (time = index * period).
-    tick: u64,
-    last: Option<(Pose, f64, String)>,
-    done: bool,
 }
 
-impl Resampler {
-    /// Resamples `src` every `period` seconds; rapids at `rapid_mm_min` (mm/min) when given.
-    pub fn new(
-        src: CsvSource,
-        period: f64,
-        rapid_mm_min: Option<f64>,
-        radians: bool,
-    ) -> Result<Resampler, VerneError> {
+impl CsvPoses {
+    /// The poses of `src`; angle columns in radians when `radians`.
+    pub fn new(src: CsvSource, radians: bool) -> Result<CsvPoses, VerneError> {
         let has = |c: &str| src.column(c).is_some();
         let orientation = if has("i") || !has("phi1") {
             let c = src.require(&["x", "y", "z", "i", "j", "k"])?;
@@ -90,20 +108,14 @@ impl Resampler {
                 "--period times each move by its feed: the input needs a `feed` column (mm/min), as CL files and G-code programs give",
             ));
         }
-        Ok(Resampler {
+        Ok(CsvPoses {
             line: src.column("line"),
             motion: src.column("motion"),
             feed: src.column("feed"),
             dt: src.column("dt"),
             xyz: [xyz[0], xyz[1], xyz[2]],
             orientation,
-            period,
-            rapid_mm_min,
             rec: ByteRecord::new(),
-            current: None,
-            tick: 0,
-            last: None,
-            done: false,
             src,
         })
     }
@@ -117,8 +129,18 @@ impl Resampler {
         })
     }
 
-    /// The next pose of the input and its line, or `None` at the end.
-    fn next_pose(&mut self) -> io::Result<Option<(Pose, String)>> {
+    /// A cell that may hold a number: its value, or None (empty, or not a number).
+    fn optional(&self, i: Option<usize>) -> Option<f64> {
+        i.and_then(|i| parse_number(self.rec.get(i).unwrap_or(b"")).ok())
+    }
+}
+
+impl PoseStream for CsvPoses {
+    fn states_angles(&self) -> bool {
+        matches!(self.orientation, Orientation::Angles(..))
+    }
+
+    fn next_pose(&mut self) -> io::Result<Option<PathPose>> {
         let more = self
             .src
             .read(&mut self.rec)
@@ -163,34 +185,76 @@ impl Resampler {
                 tool_axis(p1, p2)
             }
         };
-        Ok(Some((Pose { tip, axis, angles }, line)))
-    }
-
-    /// The time of the move from `a` to the current record's pose `b` (s).
-    fn duration(&self, a: &Pose, b: &Pose, line: &str) -> io::Result<f64> {
-        if let Some(i) = self.dt
-            && let Ok(dt) = parse_number(self.rec.get(i).unwrap_or(b""))
-        {
-            return Ok(dt.max(0.0));
-        }
         let rapid = self
             .motion
             .is_some_and(|i| self.rec.get(i).is_some_and(|m| m == b"rapid"));
-        let rate = if rapid {
+        Ok(Some(PathPose {
+            tip,
+            axis,
+            angles,
+            feed_mm_min: self.optional(self.feed),
+            dt: self.optional(self.dt),
+            rapid,
+            line,
+        }))
+    }
+}
+
+/// A toolpath resampled at a period; rows `line,t,x,y,z,i,j,k`, or `line,t,x,y,z,phi1,phi2`
+/// when the input states its angles.
+pub struct Resampler {
+    poses: Box<dyn PoseStream>,
+    /// The samples' angles and their unit, when the input states angles: Some(radians).
+    angles_out: Option<bool>,
+    period: f64,
+    rapid_mm_min: Option<f64>,
+    current: Option<Move>,
+    /// Index of the next sample (time = index * period).
+    tick: u64,
+    last: Option<(Pose, f64, String)>,
+    done: bool,
+}
+
+impl Resampler {
+    /// Resamples `poses` every `period` seconds; rapids at `rapid_mm_min` (mm/min) when given;
+    /// angles written in radians when `radians` (as the rows' reader will read them).
+    pub fn new(
+        poses: Box<dyn PoseStream>,
+        period: f64,
+        rapid_mm_min: Option<f64>,
+        radians: bool,
+    ) -> Resampler {
+        Resampler {
+            angles_out: poses.states_angles().then_some(radians),
+            poses,
+            period,
+            rapid_mm_min,
+            current: None,
+            tick: 0,
+            last: None,
+            done: false,
+        }
+    }
+
+    /// The time of the move from `a` to `b` (s): as the input states it, else its length (or,
+    /// when the tip stays, the axis's turn in degrees) at its feed or the rapid rate.
+    fn duration(&self, a: &Pose, b: &Pose, to: &PathPose) -> io::Result<f64> {
+        if let Some(dt) = to.dt {
+            return Ok(dt.max(0.0));
+        }
+        let line = &to.line;
+        let rate = if to.rapid {
             self.rapid_mm_min.ok_or_else(|| {
                 invalid_data(format!(
                     "line {line}: a rapid move: --period needs the machine's rapid rate to time it (--rapid MM_MIN)"
                 ))
             })?
         } else {
-            self.feed
-                .and_then(|i| parse_number(self.rec.get(i).unwrap_or(b"")).ok())
-                .filter(|f| *f > 0.0)
-                .ok_or_else(|| {
-                    invalid_data(format!(
-                        "line {line}: a feed move without a feed: --period times each move by its feed"
-                    ))
-                })?
+            to.feed_mm_min.filter(|f| *f > 0.0).ok_or_else(|| {
+                invalid_data(format!(
+                    "line {line}: a feed move without a feed: --period times each move by its feed"
+                ))
+            })?
         };
         let length = (b.tip - a.tip).norm();
         let turn = a.axis.angle(&b.axis).to_degrees();
@@ -199,11 +263,24 @@ impl Resampler {
     }
 
     fn write_sample(&self, out: &mut Vec<u8>, line: &str, t: f64, p: &Pose) -> io::Result<()> {
-        writeln!(
-            out,
-            "{line},{t:.6},{},{},{},{},{},{}",
-            p.tip.x, p.tip.y, p.tip.z, p.axis.x, p.axis.y, p.axis.z
-        )
+        write!(out, "{line},{t:.6},{},{},{},", p.tip.x, p.tip.y, p.tip.z)?;
+        match (self.angles_out, p.angles) {
+            (Some(radians), Some((p1, p2))) => {
+                let unit = |v: f64| if radians { v } else { v.to_degrees() };
+                writeln!(out, "{},{}", unit(p1), unit(p2))
+            }
+            _ => writeln!(out, "{},{},{}", p.axis.x, p.axis.y, p.axis.z),
+        }
+    }
+}
+
+impl PathPose {
+    fn pose(&self) -> Pose {
+        Pose {
+            tip: self.tip,
+            axis: self.axis,
+            angles: self.angles,
+        }
     }
 }
 
@@ -224,7 +301,11 @@ fn between(a: &Pose, b: &Pose, s: f64) -> Pose {
 
 impl CsvRows for Resampler {
     fn header(&self) -> &'static [u8] {
-        b"line,t,x,y,z,i,j,k\n"
+        if self.angles_out.is_some() {
+            b"line,t,x,y,z,phi1,phi2\n"
+        } else {
+            b"line,t,x,y,z,i,j,k\n"
+        }
     }
 
     fn next_row(&mut self, out: &mut Vec<u8>) -> io::Result<bool> {
@@ -254,7 +335,7 @@ impl CsvRows for Resampler {
             if self.done {
                 return Ok(false);
             }
-            match self.next_pose()? {
+            match self.poses.next_pose()? {
                 None => {
                     self.done = true;
                     // The end of the path, if it fell between two ticks.
@@ -268,8 +349,9 @@ impl CsvRows for Resampler {
                     }
                     return Ok(false);
                 }
-                Some((b, line)) => match self.last.take() {
+                Some(to) => match self.last.take() {
                     None => {
+                        let (b, line) = (to.pose(), to.line);
                         self.last = Some((b, 0.0, line.clone()));
                         self.current = Some(Move {
                             a: b,
@@ -280,7 +362,9 @@ impl CsvRows for Resampler {
                         });
                     }
                     Some((a, t0, _)) => {
-                        let d = self.duration(&a, &b, &line)?;
+                        let b = to.pose();
+                        let d = self.duration(&a, &b, &to)?;
+                        let line = to.line;
                         let t1 = t0 + d;
                         self.last = Some((b, t1, line.clone()));
                         self.current = Some(Move { a, b, t0, t1, line });

@@ -130,6 +130,12 @@ struct Candidate {
     theta2: f64,
 }
 
+/// The rotary axis of tool angles: theta2 = -phi2 in (-pi, pi] (AIM 2007 eq. (8)); `+ 0.0` so
+/// that phi2 = 0, the table normal as a program states it, gives theta2 = 0, not -0.
+fn theta2_of(angles: &ToolAngles) -> f64 {
+    wrap_angle(-angles.phi2) + 0.0
+}
+
 /// theta2 + 2 k pi nearest `reference`.
 fn unwrap_near(theta2: f64, reference: f64) -> f64 {
     reference + wrap_angle(theta2 - reference)
@@ -239,7 +245,7 @@ pub fn path_candidates_into(
                 branch,
                 angles,
                 orientation: label,
-                theta2: wrap_angle(-angles.phi2),
+                theta2: theta2_of(&angles),
             });
         }
     }
@@ -303,7 +309,7 @@ impl PathState {
         let unwrapped: ArrayVec<(u8, f64), 2> = options
             .iter()
             .map(|&(angles, label)| {
-                let t = wrap_angle(-angles.phi2);
+                let t = theta2_of(&angles);
                 (
                     label,
                     self.reference_theta2().map_or(t, |r| unwrap_near(t, r)),
