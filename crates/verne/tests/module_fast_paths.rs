@@ -565,3 +565,35 @@ fn lanes_match_the_complete_solver_through_hand_over_places() {
         "{by_lanes} of {rows_present}"
     );
 }
+
+/// The tracker answers a row only within its certified radius (CERTIFIED_FRACTION of the
+/// isolation radius 2 / (beta L)), not wherever its chord iteration converges: moving the three
+/// sliders together moves the platform straight along z, where the Jacobian does not change, so
+/// the iteration converges at once whatever the jump; a 5 mm jump is certified, a 9 mm one is
+/// not and goes to the complete solution (the radius is about 7 mm here).
+#[test]
+fn the_tracker_answers_only_within_its_certified_radius() {
+    let m = Machine::default_verne();
+    let rho0 = Sliders::new(368.354796, 84.956547, 179.032689);
+    for (jump, certified) in [(5.0, true), (9.0, false)] {
+        let mut t = FkTracker::new(&m);
+        let mut out = FkModes::default();
+        t.working_into(&rho0, &mut out);
+        let steps_before = t.chord_steps;
+        let rho = rho0 + Sliders::new(jump, jump, jump);
+        t.working_into(&rho, &mut out);
+        assert!(
+            t.chord_steps - steps_before <= 4,
+            "the iteration converges in a few steps (of 8 allowed)"
+        );
+        assert_eq!(
+            (t.tracked, t.solved),
+            if certified { (1, 1) } else { (0, 2) },
+            "{jump} mm"
+        );
+        let w = fk::working(&out).unwrap();
+        let all = fk::solve(&m, &rho);
+        let e = fk::working(&all).unwrap();
+        assert!((w.pose.p - e.pose.p).amax() < 1e-9 && (w.pose.alpha - e.pose.alpha).abs() < 1e-12);
+    }
+}
