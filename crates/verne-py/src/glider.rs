@@ -386,8 +386,106 @@ fn glider_workspace<'py>(
     Ok(d)
 }
 
+/// Tables 1 and 2 of the comparative study (Wenger, Gosselin, Chablat 2001), computed beside
+/// the paper's values, as `verne design`: each architecture dimensioned for strut length L = 1
+/// under `lambda_bounds` (default 1/3 .. 3), its workspace sampled on `nodes` along the longer
+/// side. Returns `{"table1": [...], "table2": [...]}`, one dict per row with the CLI's columns
+/// (`*_paper` None where the paper printed nothing; relative differences (computed - paper) /
+/// paper).
+#[pyfunction]
+#[pyo3(signature = (lambda_bounds=None, nodes=1201, target_area=1.0))]
+fn design_tables<'py>(
+    py: Python<'py>,
+    lambda_bounds: Option<(f64, f64)>,
+    nodes: usize,
+    target_area: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let bounds = lambda_bounds.map_or(PAPER_LAMBDA_BOUNDS, |(lo, hi)| [lo, hi]);
+    let bounds_ok =
+        bounds[0].is_finite() && bounds[1].is_finite() && 0.0 < bounds[0] && bounds[0] < bounds[1];
+    let area_ok = target_area.is_finite() && target_area > 0.0;
+    if !(bounds_ok && area_ok && (2..=20_001).contains(&nodes)) {
+        return Err(PyValueError::new_err(format!(
+            "lambda_bounds={:?}, nodes={nodes}, target_area={target_area}: expected 0 < lo < hi, 2 <= nodes <= 20001, a positive area",
+            (bounds[0], bounds[1])
+        )));
+    }
+    let opts = glider::DesignOptions {
+        bounds,
+        nodes,
+        target_area,
+        ..glider::DesignOptions::default()
+    };
+    let (t1, t2) = py.allow_threads(|| {
+        let t1 = glider::table1(&opts);
+        let t2 = glider::table2(&t1, target_area);
+        (t1, t2)
+    });
+    let rows1 = t1
+        .iter()
+        .map(|r| {
+            let d = PyDict::new(py);
+            d.set_item("mechanism", &r.mechanism)?;
+            for (k, v) in [
+                ("l0_paper", r.l0_paper),
+                ("l0", r.l0),
+                ("l0_rel_diff", r.l0_rel_diff),
+                ("delta_rho_paper", r.delta_rho_paper),
+                ("delta_rho", r.delta_rho),
+                ("delta_rho_rel_diff", r.delta_rho_rel_diff),
+                ("s_paper", r.s_paper),
+                ("s", r.s),
+                ("s_rel_diff", r.s_rel_diff),
+                ("s_width", r.s_width),
+                ("s_height", r.s_height),
+                ("s_angle_deg", r.s_angle_deg),
+                ("square", r.square),
+                ("square_angle_deg", r.square_angle_deg),
+                ("envelope", r.envelope),
+            ] {
+                d.set_item(k, v)?;
+            }
+            Ok(d)
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    let rows2 = t2
+        .iter()
+        .map(|r| {
+            let d = PyDict::new(py);
+            d.set_item("mechanism", &r.mechanism)?;
+            d.set_item("target", r.target.name())?;
+            for (k, v) in [
+                ("l0_paper", r.l0_paper),
+                ("l0_rel_diff", r.l0_rel_diff),
+                ("l_paper", r.l_paper),
+                ("l_rel_diff", r.l_rel_diff),
+                ("delta_rho_paper", r.delta_rho_paper),
+                ("delta_rho_rel_diff", r.delta_rho_rel_diff),
+                ("envelope_paper", r.envelope_paper),
+                ("envelope_rel_diff", r.envelope_rel_diff),
+            ] {
+                d.set_item(k, v)?;
+            }
+            for (k, v) in [
+                ("l0", r.l0),
+                ("l", r.l),
+                ("delta_rho", r.delta_rho),
+                ("envelope", r.envelope),
+            ] {
+                d.set_item(k, v)?;
+            }
+            Ok(d)
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    let d = PyDict::new(py);
+    d.set_item("table1", rows1)?;
+    d.set_item("table2", rows2)?;
+    Ok(d)
+}
+
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyGlider>()?;
+    m.add_function(wrap_pyfunction!(design_tables, m)?)?;
     m.add_function(wrap_pyfunction!(glider_ik, m)?)?;
     m.add_function(wrap_pyfunction!(glider_fk, m)?)?;
     m.add_function(wrap_pyfunction!(glider_workspace, m)?)?;

@@ -84,3 +84,25 @@ def test_glider_bad_rows():
     assert list(count) == [0, 0] and np.isnan(r).all()
     with pytest.raises(ValueError, match=r"\(N, 2\)"):
         verne.glider_ik(g, np.zeros((2, 3)))
+
+
+def test_design_tables_are_verne_design():
+    mine = verne.design_tables(nodes=301)
+    stdout, _ = run("design", "--csv", "--nodes", "301")
+    rows = [line.split(",") for line in stdout.strip().splitlines()[1:]]
+    header = stdout.splitlines()[0].split(",")
+    assert header[:6] == ["table", "mechanism", "target", "quantity", "unit", "computed"]
+    t1 = {r["mechanism"]: r for r in mine["table1"]}
+    t2 = {(r["mechanism"], r["target"]): r for r in mine["table2"]}
+    checked = 0
+    for table, mech, target, quantity, _, computed, *_ in rows:
+        row = t1[mech] if table == "1" else t2[(mech, target)]
+        if quantity in row:
+            assert row[quantity] == pytest.approx(float(computed), rel=1e-12), (table, mech, quantity)
+            checked += 1
+    assert len(mine["table1"]) == 3 and len(mine["table2"]) == 6 and checked >= 30
+    # Table 1 against the paper (printed to three or four digits): L0 and delta-rho within 0.5 %.
+    assert all(abs(r["l0_rel_diff"]) < 5e-3 for r in mine["table1"])
+    assert all(abs(r["delta_rho_rel_diff"]) < 5e-3 for r in mine["table1"])
+    with pytest.raises(ValueError, match="nodes"):
+        verne.design_tables(nodes=1)

@@ -161,3 +161,8 @@ def glider_workspace(
     lambda_bounds: Union[None, bool, Tuple[float, float]] = None,
     shape_angles: Optional[List[float]] = None,
 ) -> Dict[str, Any]: ...
+def design_tables(
+    lambda_bounds: Optional[Tuple[float, float]] = None,
+    nodes: int = 1201,
+    target_area: float = 1.0,
+) -> Dict[str, List[Dict[str, Any]]]: ...
