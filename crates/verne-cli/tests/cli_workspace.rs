@@ -244,3 +244,70 @@ fn a_sweep_row_is_the_workspace_of_that_machine() {
     assert_eq!(bad.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("module.L1"));
 }
+
+#[test]
+fn a_sweep_draws_its_volumes_and_gives_the_binding_shares() {
+    let dir = std::env::temp_dir().join(format!("verne-sweep-plot-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let svg = dir.join("sweep.svg");
+    let o = run(
+        &[
+            "workspace",
+            "--step",
+            "40",
+            "--sweep",
+            "module.L1=800..850:2",
+            "--sweep",
+            "module.L2=800..820:2",
+            "--plot",
+            svg.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let text = String::from_utf8_lossy(&o.stdout).into_owned();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let shares: Vec<usize> = (0..header.len())
+        .filter(|&k| header[k].starts_with("share_"))
+        .collect();
+    assert_eq!(shares.len(), 6, "{header:?}");
+    for line in text.lines().skip(1) {
+        let cells: Vec<&str> = line.split(',').collect();
+        // Every lattice point outside has one binding constraint: the shares add up to 1.
+        let sum: f64 = shares
+            .iter()
+            .map(|&k| cells[k].parse::<f64>().unwrap())
+            .sum();
+        assert!((sum - 1.0).abs() < 5e-4, "{line}");
+    }
+    assert_eq!(text.lines().count(), 5);
+    let picture = std::fs::read_to_string(&svg).unwrap();
+    for label in [
+        "module.L1",
+        "module.L2 = 800",
+        "module.L2 = 820",
+        "workspace volume (l)",
+    ] {
+        assert!(picture.contains(label), "{label} missing from the picture");
+    }
+    // A picture path that cannot be written is refused before the sweep runs.
+    let bad = run(
+        &[
+            "workspace",
+            "--step",
+            "40",
+            "--sweep",
+            "module.L1=800..850:2",
+            "--plot",
+            "x.gif",
+        ],
+        None,
+    );
+    assert_eq!(bad.status.code(), Some(2));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -68,7 +68,7 @@ pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
     let source = match (args.period, source) {
         // A program's poses straight from its reader, angle words and all.
         (Some(period), Source::Program(rows, name)) => {
-            let rows = Resampler::new(Box::new(rows), period, args.rapid, args.common.radians);
+            let rows = Resampler::new(rows, period, args.rapid, args.common.radians);
             CsvSource::from_reader(Box::new(AsCsv::new(rows)), &name)?.with_line_column("line")
         }
         (None, program @ Source::Program(..)) => program.into_csv()?,
@@ -178,7 +178,7 @@ type Summaries = (
 /// by the row engine, or straight from the reader by `--period`).
 enum Source {
     Csv(CsvSource),
-    Program(TcpRows, String),
+    Program(Box<TcpRows>, String),
 }
 
 impl Source {
@@ -187,7 +187,7 @@ impl Source {
         match self {
             Source::Csv(src) => Ok(src),
             Source::Program(rows, name) => Ok(CsvSource::from_reader(
-                Box::new(TcpAsCsv::new(rows)),
+                Box::new(TcpAsCsv::new(*rows)),
                 &name,
             )?
             .with_line_column("line")),
@@ -214,7 +214,7 @@ fn open_source(args: &IkArgs, machine: &Machine) -> Result<(Source, Summaries), 
             PathInput::Gcode(reader, name) => {
                 let rows = TcpRows::new(*reader, &name, &machine.gcode);
                 let summary = Some((rows.summary(), name.clone()));
-                (Source::Program(rows, name), (None, summary))
+                (Source::Program(Box::new(rows), name), (None, summary))
             }
             PathInput::Cl(reader, name) => {
                 let rows = ClRows::new(*reader);

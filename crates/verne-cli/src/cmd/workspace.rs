@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use crate::error::VerneError;
+use crate::plot::sweep::{SweepPoint, sweep_picture};
 use crate::plot::{self, View};
 use crate::report::workspace::{POINTS_HEADER, write_point};
 use crate::table::Sink;
@@ -69,10 +70,19 @@ fn run_sweep(
     // Every machine first: a value that makes an invalid machine stops the sweep before it runs.
     let mut machines = Vec::with_capacity(points.len());
     for p in &points {
+        // Each section once (two keys of one section, module.L1 and module.L2, share it).
         let mut text = String::from("base = \"swept\"\n");
+        let mut sections: Vec<(&str, Vec<String>)> = Vec::new();
         for (key, v) in keys.iter().zip(p) {
             let (section, name) = key.split_once('.').unwrap_or(("", key));
-            text.push_str(&format!("[{section}]\n{name} = {v:?}\n"));
+            let line = format!("{name} = {v:?}");
+            match sections.iter_mut().find(|(s, _)| *s == section) {
+                Some((_, lines)) => lines.push(line),
+                None => sections.push((section, vec![line])),
+            }
+        }
+        for (section, lines) in sections {
+            text.push_str(&format!("[{section}]\n{}\n", lines.join("\n")));
         }
         let label = keys
             .iter()
@@ -105,8 +115,15 @@ fn run_sweep(
         ]
         .map(String::from),
     );
+    // The binding constraints' shares of the lattice points outside.
+    header.extend(
+        Outcome::ALL[1..]
+            .iter()
+            .map(|o| format!("share_{}", o.code())),
+    );
     sink.write(&ByteRecord::from(header))?;
     let mut any_empty = false;
+    let mut drawn = Vec::with_capacity(points.len());
     for (p, m) in points.iter().zip(&machines) {
         let opts = options(of, m.tool_length, step, bounds, lambda);
         let start = Instant::now();
@@ -131,7 +148,19 @@ fn run_sweep(
         }
         row.push(a.classified.to_string());
         row.push(format!("{secs:.2}"));
+        let outside = (a.lattice_points - a.inside_points).max(1) as f64;
+        row.extend(
+            a.binding[1..]
+                .iter()
+                .map(|&n| format!("{:.4}", n as f64 / outside)),
+        );
         sink.write(&ByteRecord::from(row))?;
+        drawn.push(SweepPoint {
+            keys: p.clone(),
+            volume_l: a.volume_mm3 * 1e-6,
+            lo_l: a.volume_lo_mm3 * 1e-6,
+            hi_l: a.volume_hi_mm3 * 1e-6,
+        });
         sayln!(
             "verne workspace: {}: {:.3} l in {secs:.1} s",
             keys.iter()
@@ -143,6 +172,16 @@ fn run_sweep(
         );
     }
     sink.finish()?;
+    if let Some(path) = &args.plot {
+        let title = format!(
+            "{} workspace of `{}` against {}: adaptive, step {step} mm",
+            of.name(),
+            machine.name,
+            keys.join(" and ")
+        );
+        sweep_picture(path, &keys, &drawn, &title)
+            .map_err(|e| VerneError::io(&path.display().to_string(), std::io::Error::other(e)))?;
+    }
     Ok(if any_empty { EXIT_ROWS_FAILED } else { EXIT_OK })
 }
 
@@ -279,13 +318,12 @@ pub fn run(args: &WorkspaceArgs) -> Result<u8, VerneError> {
 
     if !args.sweep.is_empty() {
         if args.uniform
-            || args.plot.is_some()
             || !args.tool_length.is_empty()
             || args.sweep.len() > 2
             || of == Of::Platform && args.sweep.iter().any(|s| s.0 == "tool.length")
         {
             return Err(VerneError::Usage(
-                "--sweep runs adaptive workspaces over one or two machine-file keys (tool.length with --of tool or manufacturing): no --uniform, --plot or --tool-length".into(),
+                "--sweep runs adaptive workspaces over one or two machine-file keys (tool.length with --of tool or manufacturing): no --uniform or --tool-length".into(),
             ));
         }
         return run_sweep(args, &machine, of, step, bounds, lambda);

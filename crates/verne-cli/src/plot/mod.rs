@@ -137,6 +137,7 @@ macro_rules! render {
 }
 
 pub mod glider;
+pub mod sweep;
 
 fn drawing<E: std::fmt::Display>(e: E) -> String {
     format!("drawing: {e}")
