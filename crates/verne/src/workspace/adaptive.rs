@@ -128,59 +128,15 @@ pub fn compute_adaptive(
         bbox: None,
         touches_bounds: false,
     };
-    let mut tally = Tally::empty();
-    let classify_point =
-        |key: u64| classify(m, opts, &point(lattice.at(key))).outcome.index() as u8;
-    // The cells of this level by their first corner's key, sorted; at first every coarse cell.
-    let mut cells: Vec<u64> = Vec::new();
-    for k in (0..n[2] - 1).step_by(s0) {
-        for j in (0..n[1] - 1).step_by(s0) {
-            for i in (0..n[0] - 1).step_by(s0) {
-                cells.push(lattice.key([i, j, k]));
-            }
-        }
-    }
-    // The outcomes of the previous level's corners: a level keeps only its own corners, so
-    // memory follows the boundary, not every level's points.
-    let mut known = Outcomes::default();
-    let mut s = s0;
-    loop {
-        let (corners_here, new_points) =
-            level_corners(&lattice, &cells, s, &[&known], &classify_point);
-        summary.classified += new_points;
-        known = corners_here;
-        progress(summary.classified);
-        let (level, parents) = decide_level(&lattice, &cells, s, &known);
-        tally = tally.merge(&level);
-        drop(cells);
-        if s == 2 {
-            // The last level, cells of one step, slab by slab: it is most of the points.
-            let (last, new_points) =
-                finest_level(&lattice, &parents, &known, &classify_point, &|c| {
-                    progress(summary.classified + c)
-                });
-            summary.classified += new_points;
-            tally = tally.merge(&last);
-            break;
-        }
-        let h = s / 2;
-        // Eight children a parent, written in place (no growing vector), then sorted.
-        cells = vec![0u64; 8 * parents.len()];
-        cells
-            .par_chunks_mut(8)
-            .zip(parents.par_iter())
-            .for_each(|(out, &p)| {
-                for (o, c) in out.iter_mut().zip(children(&lattice, p, h)) {
-                    *o = c;
-                }
-            });
-        drop(parents);
-        cells.par_sort_unstable();
-        s = h;
-        if cells.is_empty() {
-            break;
-        }
-    }
+    let classify_point = |p: [usize; 3]| classify(m, opts, &point(p)).outcome.index() as u8;
+    // Keys of 32 bits where the lattice allows (1 mm steps over the default machine's box do):
+    // half the memory of the levels' lists.
+    let (tally, classified) = if summary.lattice_points <= u64::from(u32::MAX) {
+        refine::<u32>(&lattice, s0, &classify_point, progress)
+    } else {
+        refine::<u64>(&lattice, s0, &classify_point, progress)
+    };
+    summary.classified = classified;
     summary.inside_points = tally.inside_points;
     summary.boundary_cells = tally.boundary_cells;
     summary.binding = tally.binding;
@@ -200,6 +156,94 @@ pub fn compute_adaptive(
     Ok(summary)
 }
 
+/// The octree, level by level from the coarse cells (size `s0`) down to cells of one step:
+/// what the leaf cells add up to, and the points classified.
+fn refine<K: Key>(
+    lattice: &Lattice,
+    s0: usize,
+    classify_point: &(dyn Fn([usize; 3]) -> u8 + Sync),
+    progress: &(dyn Fn(u64) + Sync),
+) -> (Tally, u64) {
+    let n = lattice.n;
+    let mut tally = Tally::empty();
+    let mut classified = 0u64;
+    // The cells of this level by their first corner's key, sorted; at first every coarse cell.
+    let mut cells: Vec<K> = Vec::new();
+    for k in (0..n[2] - 1).step_by(s0) {
+        for j in (0..n[1] - 1).step_by(s0) {
+            for i in (0..n[0] - 1).step_by(s0) {
+                cells.push(lattice.key([i, j, k]));
+            }
+        }
+    }
+    // The outcomes of the previous level's corners: a level keeps only its own corners, so
+    // memory follows the boundary, not every level's points.
+    let mut known = Outcomes::<K>::default();
+    let mut s = s0;
+    loop {
+        let (corners_here, new_points) =
+            level_corners(lattice, &cells, s, &[&known], classify_point);
+        classified += new_points;
+        known = corners_here;
+        progress(classified);
+        let (level, parents) = decide_level(lattice, &cells, s, &known);
+        tally = tally.merge(&level);
+        drop(cells);
+        if s == 2 {
+            // The last level, cells of one step, slab by slab: it is most of the points.
+            let (last, new_points) =
+                finest_level(lattice, &parents, &known, classify_point, &|c| {
+                    progress(classified + c)
+                });
+            classified += new_points;
+            tally = tally.merge(&last);
+            break;
+        }
+        let h = s / 2;
+        // Eight children a parent, written in place (no growing vector), then sorted.
+        cells = vec![K::from_index(0); 8 * parents.len()];
+        cells
+            .par_chunks_mut(8)
+            .zip(parents.par_iter())
+            .for_each(|(out, &p)| {
+                for (o, c) in out.iter_mut().zip(children(lattice, p, h)) {
+                    *o = c;
+                }
+            });
+        drop(parents);
+        cells.par_sort_unstable();
+        s = h;
+        if cells.is_empty() {
+            break;
+        }
+    }
+    (tally, classified)
+}
+
+/// A lattice point's key: its index `i + n0 (j + n1 k)`, in 32 or 64 bits.
+trait Key: Copy + Ord + Send + Sync + Default {
+    fn from_index(i: usize) -> Self;
+    fn index(self) -> usize;
+}
+
+impl Key for u32 {
+    fn from_index(i: usize) -> u32 {
+        i as u32
+    }
+    fn index(self) -> usize {
+        self as usize
+    }
+}
+
+impl Key for u64 {
+    fn from_index(i: usize) -> u64 {
+        i as u64
+    }
+    fn index(self) -> usize {
+        self as usize
+    }
+}
+
 /// Cells of one step added up together in the last level (a slab: whole z planes of them).
 const SLAB_CELLS: usize = 1 << 17;
 
@@ -217,12 +261,12 @@ struct Lattice {
 }
 
 impl Lattice {
-    fn key(&self, p: [usize; 3]) -> u64 {
-        (p[0] + self.n[0] * (p[1] + self.n[1] * p[2])) as u64
+    fn key<K: Key>(&self, p: [usize; 3]) -> K {
+        K::from_index(p[0] + self.n[0] * (p[1] + self.n[1] * p[2]))
     }
 
-    fn at(&self, key: u64) -> [usize; 3] {
-        let k = key as usize;
+    fn at<K: Key>(&self, key: K) -> [usize; 3] {
+        let k = key.index();
         [
             k % self.n[0],
             (k / self.n[0]) % self.n[1],
@@ -239,18 +283,18 @@ impl Lattice {
 
 /// The outcomes of one level's points: sorted keys and [`super::Outcome::index`] values.
 #[derive(Default)]
-struct Outcomes {
-    keys: Vec<u64>,
+struct Outcomes<K> {
+    keys: Vec<K>,
     outcome: Vec<u8>,
 }
 
-impl Outcomes {
-    fn get(&self, key: u64) -> Option<u8> {
+impl<K: Key> Outcomes<K> {
+    fn get(&self, key: K) -> Option<u8> {
         self.keys.binary_search(&key).ok().map(|i| self.outcome[i])
     }
 
     /// The outcome of a corner of this level (every corner was classified or carried over).
-    fn at(&self, key: u64) -> u8 {
+    fn at(&self, key: K) -> u8 {
         self.get(key).unwrap_or(u8::MAX)
     }
 }
@@ -299,7 +343,7 @@ impl Tally {
 
     /// A cell of one step: agreeing, or a boundary cell whose owned points count each as
     /// classified. `known` holds its corners.
-    fn finest_cell(&mut self, lattice: &Lattice, c: [usize; 3], known: &Outcomes) {
+    fn finest_cell<K: Key>(&mut self, lattice: &Lattice, c: [usize; 3], known: &Outcomes<K>) {
         let first = known.at(lattice.key(c));
         let agree = corners(c, 1)
             .iter()
@@ -337,7 +381,7 @@ impl Tally {
 }
 
 /// The eight cells of size `h` that halve the cell of size `2 h` at `key`.
-fn children(lattice: &Lattice, key: u64, h: usize) -> impl Iterator<Item = u64> + '_ {
+fn children<K: Key>(lattice: &Lattice, key: K, h: usize) -> impl Iterator<Item = K> + '_ {
     let c = lattice.at(key);
     (0..8).map(move |k| {
         lattice.key([
@@ -350,19 +394,19 @@ fn children(lattice: &Lattice, key: u64, h: usize) -> impl Iterator<Item = u64> 
 
 /// The corners of `cells` (size `s`), each once, with their outcomes: taken from `sources`
 /// where one knows it, classified (in parallel) otherwise; and how many were classified.
-fn level_corners(
+fn level_corners<K: Key>(
     lattice: &Lattice,
-    cells: &[u64],
+    cells: &[K],
     s: usize,
-    sources: &[&Outcomes],
-    classify_point: &(dyn Fn(u64) -> u8 + Sync),
-) -> (Outcomes, u64) {
+    sources: &[&Outcomes<K>],
+    classify_point: &(dyn Fn([usize; 3]) -> u8 + Sync),
+) -> (Outcomes<K>, u64) {
     // Neighbouring cells share corners: each run of cells (consecutive keys) drops its repeats
     // before the runs are joined, so the list never holds eight per cell.
-    let mut keys: Vec<u64> = cells
+    let mut keys: Vec<K> = cells
         .par_chunks(CORNER_RUN)
         .flat_map_iter(|run| {
-            let mut k: Vec<u64> = run
+            let mut k: Vec<K> = run
                 .iter()
                 .flat_map(|&c| corners(lattice.at(c), s).map(|p| lattice.key(p)))
                 .collect();
@@ -373,10 +417,10 @@ fn level_corners(
         .collect();
     keys.par_sort_unstable();
     keys.dedup();
-    let looked_up = |k: u64| sources.iter().find_map(|o| o.get(k));
+    let looked_up = |k: K| sources.iter().find_map(|o| o.get(k));
     let outcome: Vec<u8> = keys
         .par_iter()
-        .map(|&k| looked_up(k).unwrap_or_else(|| classify_point(k)))
+        .map(|&k| looked_up(k).unwrap_or_else(|| classify_point(lattice.at(k))))
         .collect();
     let new_points = keys.par_iter().filter(|&&k| looked_up(k).is_none()).count();
     (Outcomes { keys, outcome }, new_points as u64)
@@ -385,14 +429,19 @@ fn level_corners(
 /// The leaf cells of one level (size `s` >= 2) added up, and the cells to halve: those whose
 /// corners disagree and, a guard against features thinner than a cell that reach out of the
 /// boundary, the cells next to them. `known` holds every corner of `cells`.
-fn decide_level(lattice: &Lattice, cells: &[u64], s: usize, known: &Outcomes) -> (Tally, Vec<u64>) {
+fn decide_level<K: Key>(
+    lattice: &Lattice,
+    cells: &[K],
+    s: usize,
+    known: &Outcomes<K>,
+) -> (Tally, Vec<K>) {
     let n = lattice.n;
     let inside = |p: [usize; 3]| known.at(lattice.key(p)) == INSIDE;
     let agree = |c: [usize; 3]| {
         let first = inside(c);
         corners(c, s).iter().all(|p| inside(*p) == first)
     };
-    let mixed: Vec<u64> = cells
+    let mixed: Vec<K> = cells
         .par_iter()
         .filter(|&&c| !agree(lattice.at(c)))
         .copied()
@@ -442,25 +491,27 @@ fn decide_level(lattice: &Lattice, cells: &[u64], s: usize, known: &Outcomes) ->
 /// added up slab by slab along z (so that only one slab's points are held), each slab's cells
 /// in parallel. A corner's outcome comes from `known` (the level above), from the previous slab
 /// (the plane two slabs share), or is classified. Returns the tally and the points classified.
-fn finest_level(
+fn finest_level<K: Key>(
     lattice: &Lattice,
-    parents: &[u64],
-    known: &Outcomes,
-    classify_point: &(dyn Fn(u64) -> u8 + Sync),
+    parents: &[K],
+    known: &Outcomes<K>,
+    classify_point: &(dyn Fn([usize; 3]) -> u8 + Sync),
     progress: &dyn Fn(u64),
 ) -> (Tally, u64) {
-    let plane = (lattice.n[0] * lattice.n[1]) as u64;
+    let plane = lattice.n[0] * lattice.n[1];
     let mut tally = Tally::empty();
     let mut classified = 0u64;
-    let mut previous = Outcomes::default();
+    let mut previous = Outcomes::<K>::default();
     let mut start = 0;
     while start < parents.len() {
         // Whole planes of parents (z of the parents' first corners), at least SLAB_CELLS.
         let mut end = (start + SLAB_CELLS).min(parents.len());
-        while end < parents.len() && parents[end] / plane == parents[end - 1] / plane {
+        while end < parents.len()
+            && parents[end].index() / plane == parents[end - 1].index() / plane
+        {
             end += 1;
         }
-        let cells: Vec<u64> = parents[start..end]
+        let cells: Vec<K> = parents[start..end]
             .par_iter()
             .flat_map_iter(|&p| children(lattice, p, 1))
             .collect();
