@@ -42,6 +42,12 @@ type ToolPoses<'py> = (
 /// none); `status[N]` 0 ok, 1 unreachable (no real branch, proved), 2 no working branch (real
 /// branches exist, none within the limits, or the list is not proved complete), 3 invalid
 /// input (NaN, zero axis).
+///
+/// >>> tips = np.array([[80.0, 0.0, 30.0], [80.0, 5.0, 30.0]])
+/// >>> axes = np.array([[0.342020, 0.0, 0.939693]] * 2)
+/// >>> joints, orientation, status = verne.ik_path(m, tips, axes)
+/// >>> joints[0].round(3).tolist(), status.tolist()
+/// ([367.636, 320.864, 307.56, -0.355, -1.571], [0, 0])
 #[pyfunction]
 #[pyo3(signature = (machine, tips, axes, tool_length=None, prefer="smallest-theta1"))]
 fn ik_path<'py>(
@@ -126,6 +132,10 @@ fn ik_path<'py>(
 /// Returns `(tips, axes, status)`: `tips[N, 3]` the tool tip (mm) and `axes[N, 3]` the tool
 /// axis in the workpiece frame, NaN where the row has no working mode; `status[N]` as in
 /// `ik_path`.
+///
+/// >>> tips, axes, status = verne.machine_fk_working(m, np.array([[367.636, 320.864, 307.560, -0.355, -1.5708]]))
+/// >>> tips.round(1).tolist(), status.tolist()
+/// ([[80.0, 0.0, 30.0]], [0])
 #[pyfunction]
 #[pyo3(signature = (machine, joints, tool_length=None))]
 fn machine_fk_working<'py>(
@@ -201,6 +211,10 @@ type PoseBranch = ([f64; 5], i8, [i8; 3], bool);
 /// `orientation[N, 48]` 1 or 2; `config[N, 48, 3]` the parallel module's configuration indices;
 /// `working[N, 48]` whether the machine can be in that branch; `proved[N]` whether the list is
 /// certified complete (False for an invalid row: NaN, zero axis).
+///
+/// >>> q, orientation, config, working, count, proved = verne.machine_ik(m, np.array([[80.0, 0.0, 30.0]]), np.array([[0.342020, 0.0, 0.939693]]))
+/// >>> int(count[0]), int(working[0].sum()), sorted(set(orientation[0, :32].tolist()))
+/// (32, 2, [1, 2])
 #[pyfunction]
 #[pyo3(signature = (machine, tips, axes, tool_length=None))]
 fn machine_ik<'py>(
@@ -297,6 +311,10 @@ type ToolMode = ([f64; 3], [f64; 3], [i8; 3], bool);
 /// Returns `(tips, axes, config, working, count, proved)`: `tips[N, 16, 3]` the tool tip (mm)
 /// and `axes[N, 16, 3]` the tool axis in the workpiece frame, NaN past `count[i]`; the rest as
 /// in `machine_ik`. `machine_fk_working` gives the working mode alone.
+///
+/// >>> tips, axes, config, working, count, proved = verne.machine_fk(m, np.array([[500.0, 600.0, 400.0, 0.2, 0.3]]))
+/// >>> int(count[0]), int(working[0].sum()), bool(proved[0])
+/// (4, 1, True)
 #[pyfunction(name = "machine_fk")]
 #[pyo3(signature = (machine, joints, tool_length=None))]
 fn machine_fk_all<'py>(

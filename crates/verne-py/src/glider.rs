@@ -163,6 +163,11 @@ fn padded<'py>(py: Python<'py>, rows: &[Vec<GliderSolution>], k: usize) -> Glide
 /// strut signs (+1, -1, 0 at a double root); the assembly mode (sign of det A); `ok` where the
 /// solution is a pose of the machine (working mode ++, assembly +, within the joint ranges, not
 /// singular). A row with NaN has no solution.
+///
+/// >>> g = verne.Glider.preset("orthoglide")
+/// >>> rho, mode, assembly, ok, count = verne.glider_ik(g, np.array([[0.897184, 1.192878]]))
+/// >>> int(count[0]), rho[0][ok[0]].round(4).tolist()
+/// (4, [[0.5, 0.6]])
 #[pyfunction]
 fn glider_ik<'py>(
     py: Python<'py>,
@@ -200,6 +205,11 @@ fn glider_ik<'py>(
 /// `verne fk -m GLIDER --all`: returns `(points[N, 2, 2], mode, assembly, ok, count)` as
 /// `glider_ik`, and `structural[N]`, True where the joints put the mechanism on a structural
 /// singularity (C = D with equal struts: P anywhere on a circle, count 0).
+///
+/// >>> g = verne.Glider.preset("orthoglide")
+/// >>> (points, mode, assembly, ok, count), structural = verne.glider_fk(g, np.array([[0.5, 0.6]]))
+/// >>> int(count[0]), points[0][ok[0]].round(4).tolist()
+/// (2, [[0.8972, 1.1929]])
 #[pyfunction]
 fn glider_fk<'py>(
     py: Python<'py>,
@@ -274,6 +284,10 @@ fn rectangle_dict<'py>(py: Python<'py>, r: Option<Rectangle>) -> PyResult<PyObje
 /// `verne.GLIDER_NODE_CLASSES`), `region[ny, nx]` (bool), `x[ny, nx]`, `y[ny, nx]` (node
 /// positions), `admissible_area`, `region_area`, `largest_square` and `largest_rectangle`
 /// (dicts with centre, width, height, angle, area, corners; None when the region is empty).
+///
+/// >>> w = verne.glider_workspace(verne.Glider.preset("orthoglide"), nodes=201)
+/// >>> round(w["region_area"], 2), w["class"].shape == w["region"].shape
+/// (1.23, True)
 #[pyfunction]
 #[pyo3(signature = (glider, nodes=801, mode="++", assembly="+", lambda_bounds=None, shape_angles=None))]
 fn glider_workspace<'py>(
@@ -392,6 +406,10 @@ fn glider_workspace<'py>(
 /// side. Returns `{"table1": [...], "table2": [...]}`, one dict per row with the CLI's columns
 /// (`*_paper` None where the paper printed nothing; relative differences (computed - paper) /
 /// paper).
+///
+/// >>> t = verne.design_tables(nodes=201)
+/// >>> [r["mechanism"] for r in t["table1"]], len(t["table2"])
+/// (['biglide1', 'biglide2', 'orthoglide'], 6)
 #[pyfunction]
 #[pyo3(signature = (lambda_bounds=None, nodes=1201, target_area=1.0))]
 fn design_tables<'py>(

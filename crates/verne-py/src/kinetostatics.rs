@@ -46,6 +46,12 @@ fn poses_and_sliders(
 /// `poses[N, 4]` = (xp, yp, zp in mm, alpha in rad) with its `sliders[N, 3]` (mm), a branch of
 /// `module_ik` or a mode of `module_fk`. Returns `(A[N, 4, 4], B[N, 4, 3])` with
 /// A dX + B drho = 0, X = (xp, yp, zp, alpha), unscaled (each row is d/dX of one constraint).
+///
+/// >>> P = np.array([[-240.0, -86.0, 1000.0]])
+/// >>> s, alpha, _ = verne.module_ik_working(m, P)
+/// >>> A, B = verne.jacobian(m, np.c_[P, alpha], s)
+/// >>> A.shape, B.shape
+/// ((1, 4, 4), (1, 4, 3))
 #[pyfunction]
 fn jacobian<'py>(
     py: Python<'py>,
@@ -83,6 +89,11 @@ fn jacobian<'py>(
 /// `serial_margin[N]` (smallest |cos| between a rod and its slider, 0 at a serial
 /// singularity), `amplification[N, 3]` (velocity amplification factors, largest first, inf at
 /// a parallel singularity), `rotation_rate[N, 3]` (d alpha / d rho, rad/mm).
+///
+/// >>> P = np.array([[-240.0, -86.0, 1000.0]])
+/// >>> s, alpha, _ = verne.module_ik_working(m, P)
+/// >>> verne.kinetostatics(m, np.c_[P, alpha], s)["amplification"].round(3).tolist()
+/// [[1.45, 1.286, 0.545]]
 #[pyfunction]
 fn kinetostatics<'py>(
     py: Python<'py>,

@@ -300,6 +300,10 @@ fn compact_to_python(py: Python<'_>, (b, c, w, i, o, p): CompactArrays) -> Compa
 /// indices (s1, s2, s3), 0 past the count; `working[N, 24]` whether the machine can be in that
 /// branch (configuration (-1,-1,-1), strokes, rod tilts, no crossing); `proved[N]` whether the
 /// list is certified complete. For large batches, `module_ik_compact`.
+///
+/// >>> b, config, working, count, proved = verne.module_ik(m, np.array([[-240.0, -86.0, 1000.0]]))
+/// >>> int(count[0]), bool(proved[0]), int(working[0].sum())
+/// (16, True, 1)
 #[pyfunction]
 fn module_ik<'py>(
     py: Python<'py>,
@@ -322,6 +326,10 @@ fn module_ik<'py>(
 /// `module_ik` in compact form, one row per real branch (as `verne ik --all`): returns
 /// `(branches[M, 4], config[M, 3], working[M], point[M], offsets[N + 1], proved[N])`, the
 /// branches of point i in rows `offsets[i]..offsets[i + 1]` (`point` says the same per row).
+///
+/// >>> b, config, working, point, offsets, proved = verne.module_ik_compact(m, np.array([[-240.0, -86.0, 1000.0]]))
+/// >>> b.shape, offsets.tolist()
+/// ((16, 4), [0, 16])
 #[pyfunction]
 fn module_ik_compact<'py>(
     py: Python<'py>,
@@ -341,6 +349,10 @@ fn module_ik_compact<'py>(
 /// Returns `(sliders, alpha, status)`: `sliders[N, 3]` (mm) and `alpha[N]` (rad), NaN where the
 /// point has no working branch; `status[N]` 0 ok, 1 unreachable (no real branch, proved), 2 no
 /// working branch, 3 invalid input.
+///
+/// >>> sliders, alpha, status = verne.module_ik_working(m, np.array([[-240.0, -86.0, 1000.0]]))
+/// >>> sliders.round(3).tolist(), status.tolist()
+/// ([[368.355, 84.957, 179.033]], [0])
 #[pyfunction]
 fn module_ik_working<'py>(
     py: Python<'py>,
@@ -421,6 +433,10 @@ fn module_ik_working<'py>(
 ///
 /// Returns `(modes, config, working, count, proved)`: `modes[N, 16, 4]` = (xp, yp, zp in mm,
 /// alpha in rad), NaN past `count[i]`; the rest as in `module_ik`.
+///
+/// >>> modes, config, working, count, proved = verne.module_fk(m, np.array([[674.0, 685.0, 250.0]]))
+/// >>> int(count[0]), verne.working(modes, working).round(3).tolist()
+/// (4, [[-199.799, 355.845, 1242.023, -0.227]])
 #[pyfunction]
 fn module_fk<'py>(
     py: Python<'py>,
@@ -441,6 +457,10 @@ fn module_fk<'py>(
 }
 
 /// `module_fk` in compact form, one row per real assembly mode: as `module_ik_compact`.
+///
+/// >>> modes, config, working, point, offsets, proved = verne.module_fk_compact(m, np.array([[674.0, 685.0, 250.0]]))
+/// >>> offsets.tolist(), int(working.sum())
+/// ([0, 4], 1)
 #[pyfunction]
 fn module_fk_compact<'py>(
     py: Python<'py>,

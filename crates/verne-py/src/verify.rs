@@ -144,6 +144,16 @@ fn summary_dict<'py>(py: Python<'py>, s: &Summary) -> PyResult<Bound<'py, PyDict
 /// `verne verify --help`). Returns `(findings, summary)`: a list of dicts (row, check, value,
 /// limit, detail, severity; values in the threshold's unit) in row order, and the summary dict
 /// (`summary["clean"]` True when no check failed). A row with NaN is an `input` finding.
+///
+/// >>> tips = np.array([[80.0, 0.0, 30.0], [80.0, 5.0, 30.0]])
+/// >>> axes = np.array([[0.342020, 0.0, 0.939693]] * 2)
+/// >>> joints, _, _ = verne.ik_path(m, tips, axes)
+/// >>> findings, summary = verne.verify(m, joints, tips, axes)
+/// >>> findings, summary["clean"]
+/// ([], True)
+/// >>> joints[1, 0] += 0.5                       # slider 1 of row 2 off by 0.5 mm
+/// >>> [(f["row"], f["check"]) for f in verne.verify(m, joints, tips, axes)[0]][:1]
+/// [('2', 'tip_error')]
 #[pyfunction]
 #[pyo3(signature = (machine, joints, tips, axes, t=None, feed=None, thresholds=None, tool_length=None))]
 #[allow(clippy::too_many_arguments)]

@@ -49,6 +49,10 @@ fn counts<'py>(
 /// `grid_points[N, 3]` (mm) and `outcome[N]` (int8, index into `verne.OUTCOMES`, x fastest).
 /// Returns a dict: the volume, its error, the bounding box, the largest box (uniform), the
 /// points per outcome and per failed constraint.
+///
+/// >>> w = verne.workspace(m, step=40)
+/// >>> w["method"], w["inside"], round(w["volume_litres"], 1)
+/// ('uniform', 7061, 451.9)
 #[pyfunction]
 #[pyo3(signature = (machine, of="platform", step=10.0, tool_length=None, bounds=None, lambda_bounds=None, adaptive=None, points=false))]
 #[allow(clippy::too_many_arguments)]

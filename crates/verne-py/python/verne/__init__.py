@@ -78,7 +78,14 @@ __all__ = [
 def working(branches, working_mask):
     """The machine's branch of each row: `branches[N, K, 4]` and `working[N, K]` from
     `module_ik` or `module_fk` -> `[N, 4]`, the first working branch of each row (there is at
-    most one for the VERNE machine's configuration), NaN where the row has none."""
+    most one for the VERNE machine's configuration), NaN where the row has none.
+
+    >>> import numpy as np, verne
+    >>> b, config, working, count, proved = verne.module_ik(
+    ...     verne.Machine.default(), np.array([[-240.0, -86.0, 1000.0], [1e4, 0.0, 0.0]]))
+    >>> verne.working(b, working).round(3).tolist()
+    [[368.355, 84.957, 179.033, 0.052], [nan, nan, nan, nan]]
+    """
     branches = _np.asarray(branches)
     working_mask = _np.asarray(working_mask, dtype=bool)
     if branches.ndim != 3 or working_mask.shape != branches.shape[:2]:
