@@ -62,20 +62,23 @@ fn jacobian<'py>(
     let rows = poses_and_sliders(&poses, &sliders)?;
     let g = &machine.inner.module;
     let n = rows.len();
-    let mut a = Array3::<f64>::zeros((n, 4, 4));
-    let mut b = Array3::<f64>::zeros((n, 4, 3));
-    for (i, (pose, rho)) in rows.iter().enumerate() {
-        let ja = jacobian_pose(g, pose, rho);
-        let jb = jacobian_sliders(g, pose, rho);
-        for r in 0..4 {
-            for c in 0..4 {
-                a[[i, r, c]] = ja[(r, c)];
-            }
-            for c in 0..3 {
-                b[[i, r, c]] = jb[(r, c)];
+    let (a, b) = py.allow_threads(|| {
+        let mut a = Array3::<f64>::zeros((n, 4, 4));
+        let mut b = Array3::<f64>::zeros((n, 4, 3));
+        for (i, (pose, rho)) in rows.iter().enumerate() {
+            let ja = jacobian_pose(g, pose, rho);
+            let jb = jacobian_sliders(g, pose, rho);
+            for r in 0..4 {
+                for c in 0..4 {
+                    a[[i, r, c]] = ja[(r, c)];
+                }
+                for c in 0..3 {
+                    b[[i, r, c]] = jb[(r, c)];
+                }
             }
         }
-    }
+        (a, b)
+    });
     pyo3::types::PyTuple::new(
         py,
         [a.into_pyarray(py).into_any(), b.into_pyarray(py).into_any()],

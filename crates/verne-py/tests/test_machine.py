@@ -156,3 +156,39 @@ def test_kinetostatics_against_finite_differences():
     assert (np.abs(k["det_a"]) > 0).all()
     with pytest.raises(ValueError, match="one slider triple per pose"):
         verne.kinetostatics(M, posed, sliders[:2])
+
+
+# Every array function: an empty batch gives empty results of the documented shapes, one row
+# gives one row.
+CASES = [
+    ("module_ik", lambda n: (M, np.zeros((n, 3)) + [-240.0, -86.0, 1000.0])),
+    ("module_ik_compact", lambda n: (M, np.zeros((n, 3)) + [-240.0, -86.0, 1000.0])),
+    ("module_ik_working", lambda n: (M, np.zeros((n, 3)) + [-240.0, -86.0, 1000.0])),
+    ("module_fk", lambda n: (M, np.zeros((n, 3)) + [674.0, 685.0, 250.0])),
+    ("module_fk_compact", lambda n: (M, np.zeros((n, 3)) + [674.0, 685.0, 250.0])),
+    ("ik_path", lambda n: (M, np.zeros((n, 3)) + [80.0, 0, 30], np.zeros((n, 3)) + [0, 0, 1.0])),
+    ("machine_ik", lambda n: (M, np.zeros((n, 3)) + [80.0, 0, 30], np.zeros((n, 3)) + [0, 0, 1.0])),
+    ("machine_fk", lambda n: (M, np.zeros((n, 5)) + [500.0, 600, 400, 0.2, 0.3])),
+    ("machine_fk_working", lambda n: (M, np.zeros((n, 5)) + [500.0, 600, 400, 0.2, 0.3])),
+    ("jacobian", lambda n: (M, np.zeros((n, 4)) + [0, 0, 1200.0, 0], np.zeros((n, 3)) + 500.0)),
+    ("glider_ik", lambda n: (verne.Glider.preset("orthoglide"), np.zeros((n, 2)) + [0.9, 1.2])),
+    ("glider_fk", lambda n: (verne.Glider.preset("orthoglide"), np.zeros((n, 2)) + [0.5, 0.6])),
+]
+
+
+def first_array(result):
+    while isinstance(result, tuple):
+        result = result[0]
+    return result
+
+
+@pytest.mark.parametrize("name,args", CASES)
+def test_empty_and_one_row_batches(name, args):
+    f = getattr(verne, name)
+    empty = first_array(f(*args(0)))
+    one = first_array(f(*args(1)))
+    assert empty.shape[0] == 0 and one.shape[0] >= 1, (empty.shape, one.shape)
+    assert empty.shape[1:] == one.shape[1:] or name.endswith("_compact")
+    k = verne.kinetostatics(M, *args(0)[1:]) if name == "jacobian" else None
+    if k is not None:
+        assert all(v.shape[0] == 0 for v in k.values())
