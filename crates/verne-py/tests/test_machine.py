@@ -192,3 +192,21 @@ def test_empty_and_one_row_batches(name, args):
     k = verne.kinetostatics(M, *args(0)[1:]) if name == "jacobian" else None
     if k is not None:
         assert all(v.shape[0] == 0 for v in k.values())
+
+
+def test_kinetostatics_is_verne_modes():
+    # Table III's four assembly modes: det A, the extreme amplification factors and the margins
+    # of `verne modes --csv`, mode for mode.
+    modes, _, _, count, _ = verne.module_fk(M, np.array([[674.0, 685.0, 250.0]]))
+    n = int(count[0])
+    poses = modes[0, :n]
+    k = verne.kinetostatics(M, poses, np.tile([674.0, 685.0, 250.0], (n, 1)))
+    rows = cli("modes", "--joints", "674,685,250", "--csv", "--radians")
+    assert len(rows) == n
+    for r in rows:
+        i = int(np.argmin(np.abs(poses[:, 0] - float(r["xp"])) + np.abs(poses[:, 2] - float(r["zp"]))))
+        assert k["det_a"][i] == pytest.approx(float(r["det_a"]), rel=1e-9)
+        assert k["amplification"][i].min() == pytest.approx(float(r["lambda_min"]), rel=1e-9)
+        assert k["amplification"][i].max() == pytest.approx(float(r["lambda_max"]), rel=1e-9)
+        assert k["parallel_margin"][i] == pytest.approx(float(r["parallel_margin"]), rel=1e-9)
+        assert k["serial_margin"][i] == pytest.approx(float(r["serial_margin"]), rel=1e-9)
