@@ -242,4 +242,32 @@ mod tests {
         assert_eq!(got.len(), 2, "{got:?}");
         assert_eq!(got[0].x, -1.0);
     }
+
+    #[test]
+    fn the_zero_polynomial_has_no_isolated_root() {
+        // Every coefficient zero (or none): nothing to isolate, nothing reported, no panic.
+        assert!(roots_in(&[0.0; 5], -1.0, 1.0).is_empty());
+        assert!(roots_in(&[], -1.0, 1.0).is_empty());
+        // Leading coefficients negligible next to the others are dropped: a line's root.
+        let r = roots_in(&[-1.0, 2.0, 1e-310, 0.0], -10.0, 10.0);
+        assert_eq!(r.len(), 1);
+        assert!((r[0].x - 0.5).abs() < 1e-15);
+    }
+
+    #[test]
+    fn the_error_bound_covers_the_coefficients_errors() {
+        // Coefficients each off by at most err: the value of every polynomial within those
+        // errors lies within the bound of the computed value.
+        let (c, err) = ([1.0, -2.0, 3.0, 0.5], [0.1, 0.05, 0.2, 0.01]);
+        for x in [-2.0, -0.5, 0.0, 0.7, 3.0] {
+            let (p, bound) = eval_with_coefficient_error(&c, &err, x);
+            for signs in 0..16u32 {
+                let shifted: Vec<f64> = (0..4)
+                    .map(|i| c[i] + if signs >> i & 1 == 1 { err[i] } else { -err[i] })
+                    .collect();
+                let q = eval_with_error(&shifted, x).0;
+                assert!((q - p).abs() <= bound, "x={x}: |{q} - {p}| > {bound}");
+            }
+        }
+    }
 }
