@@ -261,13 +261,21 @@ mod tests {
         let (c, err) = ([1.0, -2.0, 3.0, 0.5], [0.1, 0.05, 0.2, 0.01]);
         for x in [-2.0, -0.5, 0.0, 0.7, 3.0] {
             let (p, bound) = eval_with_coefficient_error(&c, &err, x);
+            let mut widest = 0.0f64;
             for signs in 0..16u32 {
                 let shifted: Vec<f64> = (0..4)
                     .map(|i| c[i] + if signs >> i & 1 == 1 { err[i] } else { -err[i] })
                     .collect();
                 let q = eval_with_error(&shifted, x).0;
                 assert!((q - p).abs() <= bound, "x={x}: |{q} - {p}| > {bound}");
+                widest = widest.max((q - p).abs());
             }
+            // And no wider than needed: the errors' worst case plus p's rounding bound.
+            let rounding = eval_with_error(&c, x).1;
+            assert!(
+                bound <= widest * (1.0 + 1e-9) + 2.0 * rounding,
+                "x={x}: {bound} vs {widest}"
+            );
         }
     }
 }
