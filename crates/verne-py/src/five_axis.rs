@@ -266,22 +266,16 @@ fn machine_ik<'py>(
     let mut orientation = Array2::<i8>::zeros((n, k));
     let mut config = Array3::<i8>::zeros((n, k, 3));
     let mut working = Array2::<bool>::from_elem((n, k), false);
-    let mut count = Array1::<i64>::zeros(n);
-    let mut proved = Array1::<bool>::from_elem(n, false);
-    for (i, (branches, p)) in solved.into_iter().enumerate() {
-        count[i] = branches.len() as i64;
-        proved[i] = p;
-        for (slot, (q, o, c, w)) in branches.into_iter().enumerate() {
-            for j in 0..5 {
-                joints[[i, slot, j]] = q[j];
-            }
-            for j in 0..3 {
-                config[[i, slot, j]] = c[j];
-            }
-            orientation[[i, slot]] = o;
-            working[[i, slot]] = w;
+    let (count, proved) = spread(solved, |i, slot, (q, o, c, w): PoseBranch| {
+        for j in 0..5 {
+            joints[[i, slot, j]] = q[j];
         }
-    }
+        for j in 0..3 {
+            config[[i, slot, j]] = c[j];
+        }
+        orientation[[i, slot]] = o;
+        working[[i, slot]] = w;
+    });
     Ok((
         joints.into_pyarray(py),
         orientation.into_pyarray(py),
@@ -350,20 +344,14 @@ fn machine_fk_all<'py>(
     let mut axes = Array3::<f64>::from_elem((n, k, 3), f64::NAN);
     let mut config = Array3::<i8>::zeros((n, k, 3));
     let mut working = Array2::<bool>::from_elem((n, k), false);
-    let mut count = Array1::<i64>::zeros(n);
-    let mut proved = Array1::<bool>::from_elem(n, false);
-    for (i, (modes, p)) in solved.into_iter().enumerate() {
-        count[i] = modes.len() as i64;
-        proved[i] = p;
-        for (slot, (t, a, c, w)) in modes.into_iter().enumerate() {
-            for j in 0..3 {
-                tips[[i, slot, j]] = t[j];
-                axes[[i, slot, j]] = a[j];
-                config[[i, slot, j]] = c[j];
-            }
-            working[[i, slot]] = w;
+    let (count, proved) = spread(solved, |i, slot, (t, a, c, w): ToolMode| {
+        for j in 0..3 {
+            tips[[i, slot, j]] = t[j];
+            axes[[i, slot, j]] = a[j];
+            config[[i, slot, j]] = c[j];
         }
-    }
+        working[[i, slot]] = w;
+    });
     Ok((
         tips.into_pyarray(py),
         axes.into_pyarray(py),
@@ -400,4 +388,22 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(machine_ik, m)?)?;
     m.add_function(wrap_pyfunction!(machine_fk_all, m)?)?;
     Ok(())
+}
+
+/// Each row's solutions written into padded arrays by `write(row, slot, solution)`; returns
+/// the rows' counts and certificates.
+fn spread<T>(
+    rows: Vec<(Vec<T>, bool)>,
+    mut write: impl FnMut(usize, usize, T),
+) -> (Array1<i64>, Array1<bool>) {
+    let mut count = Array1::<i64>::zeros(rows.len());
+    let mut proved = Array1::<bool>::from_elem(rows.len(), false);
+    for (i, (solutions, p)) in rows.into_iter().enumerate() {
+        count[i] = solutions.len() as i64;
+        proved[i] = p;
+        for (slot, solution) in solutions.into_iter().enumerate() {
+            write(i, slot, solution);
+        }
+    }
+    (count, proved)
 }
