@@ -543,3 +543,58 @@ fn corners(c: [usize; 3], s: usize) -> [[usize; 3]; 8] {
         ]
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::workspace::{Of, PAPER_LAMBDA_BOUNDS};
+
+    /// The 64-bit keys (lattices of 2^32 points or more, never reached by the tests through
+    /// `compute_adaptive`) give what the 32-bit keys give, level for level.
+    #[test]
+    fn both_key_widths_refine_alike() {
+        let m = Machine::default_verne();
+        let opts = WorkspaceOptions {
+            of: Of::Platform,
+            tool_length: 0.0,
+            step: 20.0,
+            bounds: None,
+            lambda: PAPER_LAMBDA_BOUNDS,
+        };
+        let b = round_bounds(&default_bounds(&m, opts.of, 0.0), opts.step);
+        let n = [0, 1, 2].map(|d| {
+            let cells = ((b.max[d] - b.min[d]) / opts.step + 1e-9).floor();
+            (cells / 8.0).ceil().max(1.0) as usize * 8 + 1
+        });
+        let lattice = Lattice { n };
+        let point = |p: [usize; 3]| {
+            b.min + nalgebra::Vector3::new(p[0] as f64, p[1] as f64, p[2] as f64) * opts.step
+        };
+        let classify_point = |p: [usize; 3]| classify(&m, &opts, &point(p)).outcome.index() as u8;
+        let (t32, c32) = refine::<u32>(&lattice, 8, &classify_point, &|_| {});
+        let (t64, c64) = refine::<u64>(&lattice, 8, &classify_point, &|_| {});
+        assert_eq!(c32, c64);
+        assert!(t32.inside_points > 0);
+        assert_eq!(
+            (
+                t32.inside_points,
+                t32.inside_cells,
+                t32.boundary_cells,
+                t32.binding,
+                t32.lo,
+                t32.hi
+            ),
+            (
+                t64.inside_points,
+                t64.inside_cells,
+                t64.boundary_cells,
+                t64.binding,
+                t64.lo,
+                t64.hi
+            )
+        );
+        // And what compute_adaptive reports (it takes the 32-bit keys here).
+        let a = compute_adaptive(&m, &opts, 8, &|_| {}).unwrap();
+        assert_eq!((a.inside_points, a.classified), (t64.inside_points, c64));
+    }
+}
