@@ -12,6 +12,8 @@
 //! - [`workspace`], [`verify`], [`selftest`]: analyses built on them;
 //! - [`glider`]: the planar glider mechanisms of the comparative study (Wenger 2001);
 //! - [`math`]: root finding, interval and double-double arithmetic, the run-time CPU dispatch;
+//! - [`stream`]: the row engine the streaming commands and [`verify`] run on (three batches
+//!   in flight: read, solved, written);
 //! - [`details`]: the fast batched entry points and the baseline builds the benchmarks compare.
 //!
 //! The `parallel` feature (on by default) runs grids and batches on rayon's threads; without it
@@ -27,6 +29,7 @@ mod par;
 pub mod parallel_module;
 pub mod selftest;
 pub mod spec;
+pub mod stream;
 pub mod tolerance;
 pub mod verify;
 pub mod workspace;

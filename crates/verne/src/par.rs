@@ -1,9 +1,11 @@
 //! Data parallelism: with the `parallel` feature, rayon's parallel iterators; without it, the
 //! same iterator chains (`par_iter`, `into_par_iter`, `with_min_len`, `flat_map_iter`,
 //! `par_chunks`, `par_chunks_mut`, `zip`, `for_each`, `filter`, `copied`, `count`, `fold(identity, op)`, `reduce(identity, op)`,
-//! `par_sort_unstable`) run in order on the calling thread. The computations they carry are
+//! `par_sort_unstable`) and `join` run in order on the calling thread. The computations they carry are
 //! independent per item and collected in order, so both give the same results.
 
+#[cfg(feature = "parallel")]
+pub(crate) use rayon::join;
 #[cfg(feature = "parallel")]
 pub(crate) use rayon::prelude::*;
 
@@ -12,6 +14,11 @@ pub(crate) use sequential::*;
 
 #[cfg(not(feature = "parallel"))]
 mod sequential {
+    /// `join(a, b)`: `a` then `b`.
+    pub(crate) fn join<A: FnOnce() -> RA, B: FnOnce() -> RB, RA, RB>(a: A, b: B) -> (RA, RB) {
+        (a(), b())
+    }
+
     /// An iterator run in order, with the methods of rayon's parallel iterators the crate uses.
     pub(crate) struct Seq<I>(I);
 

@@ -7,6 +7,7 @@
 
 use csv::ByteRecord;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use crate::error::VerneError;
 use crate::table::{CellError, CsvSource, Sink, encode_field, format_number, parse_number};
@@ -222,7 +223,8 @@ impl<S: Default> Batch<S> {
     /// Most rows a batch of this job reads: [`BATCH_ROWS`], fewer when its rows are large
     /// ([`BATCH_BYTES`]).
     fn max_rows() -> usize {
-        (BATCH_BYTES / size_of::<PendingRow<S>>().max(1)).clamp(RUN_ROWS, BATCH_ROWS)
+        let rows = (BATCH_BYTES / size_of::<PendingRow<S>>().max(1)).clamp(RUN_ROWS, BATCH_ROWS);
+        rows / RUN_ROWS * RUN_ROWS
     }
 
     fn new() -> Batch<S> {
@@ -236,11 +238,13 @@ impl<S: Default> Batch<S> {
         }
     }
 
-    /// Reads up to `rows` records, reusing the rows in place (a row can hold a solver's
+    /// Reads up to `rows` records (rounded down to whole runs of [`RUN_ROWS`], so that runs start
+    /// at the same rows whatever the batch sizes), reusing the rows in place (a row can hold a solver's
     /// fixed-capacity result, a kilobyte or more: moving rows would cost more than solving).
     fn fill(&mut self, source: &mut CsvSource, rows: usize) -> Result<(), VerneError> {
         self.filled = 0;
         self.encoded_runs = 0;
+        let rows = (rows / RUN_ROWS).max(1) * RUN_ROWS;
         while self.filled < rows {
             if self.filled == self.rows.len() {
                 self.rows.push(PendingRow {
@@ -348,13 +352,11 @@ pub fn run<J: RowJob>(
         file: &file,
         line_column: source.line_column(),
     };
-    // The loop runs on one of rayon's workers (`rayon::scope` moves it there from the calling
-    // thread, which then waits once for the whole run): its joins hand work to the other worker
-    // directly, instead of waking the calling thread and a worker at every batch.
-    rayon::scope(|_| stream_batches(job, source, sink, &plan, progress))
+    stream_batches(job, source, sink, &plan, progress)
 }
 
-/// The loop of [`run`]: three batches in flight, read, solved and written side by side.
+/// The loop of [`run`] on the core's row engine ([`verne::stream::run_batches`]): while one
+/// batch is read, the previous one is solved and encoded and the one before is written.
 fn stream_batches<J: RowJob>(
     job: &mut J,
     source: &mut CsvSource,
@@ -363,37 +365,26 @@ fn stream_batches<J: RowJob>(
     progress: Progress<'_>,
 ) -> Result<RunSummary, VerneError> {
     let mut summary = RunSummary::default();
-    let (mut reading, mut solving, mut writing) =
-        (Batch::<J::Solved>::new(), Batch::new(), Batch::new());
-    // The first batch is small: its output rows per input row size the next ones.
-    let mut batch_rows = RUN_ROWS;
-    reading.fill(source, batch_rows)?;
-    while reading.filled > 0 {
-        std::mem::swap(&mut reading, &mut solving);
-        let (read, (written, solved)) = rayon::join(
-            || reading.fill(source, batch_rows),
-            || {
-                rayon::join(
-                    || writing.write(sink),
-                    || process(job, &mut solving, plan, &mut summary),
-                )
-            },
-        );
-        written?;
-        solved?;
-        read?;
-        progress(summary.input_rows);
-        // Rows per batch for the batch after next, from this one's output rows per input row.
-        let per_input = solving
-            .out_input
-            .len()
-            .div_ceil(solving.filled.max(1))
-            .max(1);
-        batch_rows =
-            (BATCH_OUTPUT_ROWS / per_input).clamp(RUN_ROWS, Batch::<J::Solved>::max_rows());
-        std::mem::swap(&mut solving, &mut writing);
-    }
-    writing.write(sink)?;
+    // Rows per batch, from the output rows per input row of the last batch solved. The first
+    // batch is small: its output rows per input row size the next ones.
+    let batch_rows = AtomicUsize::new(RUN_ROWS);
+    let max_rows = Batch::<J::Solved>::max_rows();
+    verne::stream::run_batches(
+        [Batch::new(), Batch::new(), Batch::new()],
+        |batch: &mut Batch<J::Solved>| {
+            batch.fill(source, batch_rows.load(Ordering::Relaxed))?;
+            Ok(batch.filled > 0)
+        },
+        |batch: &mut Batch<J::Solved>| {
+            process(job, batch, plan, &mut summary)?;
+            progress(summary.input_rows);
+            let per_input = batch.out_input.len().div_ceil(batch.filled.max(1)).max(1);
+            let rows = (BATCH_OUTPUT_ROWS / per_input).clamp(RUN_ROWS, max_rows);
+            batch_rows.store(rows, Ordering::Relaxed);
+            Ok(())
+        },
+        |batch: &mut Batch<J::Solved>| batch.write(sink),
+    )?;
     Ok(summary)
 }
 

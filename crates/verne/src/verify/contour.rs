@@ -15,9 +15,8 @@
 //! counted with sin(phi1), its arc on the sphere of axes), the point on it by a golden-section
 //! search on that distance.
 
-use std::cell::RefCell;
 use std::f64::consts::PI;
-use std::rc::Rc;
+use std::sync::{Arc, Mutex};
 
 use nalgebra::{SVector, Vector3};
 
@@ -261,7 +260,7 @@ impl ContourPath {
 }
 
 /// The last joint row read, shared between the joint source and the path it is projected on.
-type LastRow = Rc<RefCell<Option<Result<Joints, String>>>>;
+type LastRow = Arc<Mutex<Option<Result<Joints, String>>>>;
 
 /// The recording, remembering each row for [`Projected`].
 struct Tee<'a, J> {
@@ -283,7 +282,8 @@ impl<J: JointSource> RowSource for Tee<'_, J> {
 
     fn next_item(&mut self) -> Result<Option<Item<Joints>>, J::Error> {
         let item = self.inner.next_item()?;
-        *self.last.borrow_mut() = item.as_ref().map(|i| i.value.clone());
+        *self.last.lock().unwrap_or_else(|e| e.into_inner()) =
+            item.as_ref().map(|i| i.value.clone());
         Ok(item)
     }
 }
@@ -319,7 +319,7 @@ impl<E> RowSource for Projected<'_, E> {
     }
 
     fn next_item(&mut self) -> Result<Option<Item<PathPoint>>, E> {
-        let Some(row) = self.last.borrow_mut().take() else {
+        let Some(row) = self.last.lock().unwrap_or_else(|e| e.into_inner()).take() else {
             return Ok(None);
         };
         self.index += 1;
@@ -360,14 +360,14 @@ pub fn verify_recording<J, E>(
     joints: &mut J,
     path: ContourPath,
     path_name: &str,
-    report: &mut dyn FnMut(&Violation) -> Result<(), E>,
+    report: &mut (dyn FnMut(&Violation) -> Result<(), E> + Send),
 ) -> Result<Summary, E>
 where
-    J: JointSource<Error = E>,
-    E: From<PairingError>,
+    J: JointSource<Error = E> + Send,
+    E: From<PairingError> + Send,
 {
     assert!(!path.is_empty(), "verify_recording needs a path");
-    let last: LastRow = Rc::new(RefCell::new(None));
+    let last: LastRow = Arc::new(Mutex::new(None));
     let mut tee = Tee {
         inner: joints,
         last: last.clone(),

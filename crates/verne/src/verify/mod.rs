@@ -13,9 +13,11 @@
 //!   interpolated joints, the assembly mode, rod tilts, singularity proximity and the chordal
 //!   error at the midpoint.
 //!
-//! Streaming: rows are read in batches of [`BATCH_ROWS`]; each batch is solved in parallel (rayon)
-//! and reported in input order, so memory does not grow with the files and results do not depend
-//! on the number of threads. Only the previous row and segment are kept between batches.
+//! Streaming, on the row engine of the streaming commands ([`crate::stream`]): rows are paired
+//! in batches of [`BATCH_ROWS`]; while one batch is read, the previous one is solved in parallel
+//! (rayon) and the one before is reported, in input order, so memory does not grow with the
+//! files and results do not depend on the number of threads. Only the previous row and segment
+//! are kept between batches.
 
 pub mod contour;
 mod findings;
@@ -332,6 +334,23 @@ enum Pairer {
     },
 }
 
+/// The rows in flight in the row engine ([`crate::stream`]): read as pairs, their findings
+/// kept for the write stage.
+struct VerifyBatch {
+    /// Each joint row with its intended pose, and whether a pairing gap comes before it.
+    pairs: Vec<(Paired, bool)>,
+    findings: Vec<Violation>,
+}
+
+impl VerifyBatch {
+    fn new() -> VerifyBatch {
+        VerifyBatch {
+            pairs: Vec::with_capacity(BATCH_ROWS),
+            findings: Vec::new(),
+        }
+    }
+}
+
 /// A joint row with its intended pose (None: no partner in the path).
 struct Paired {
     joints: Item<Joints>,
@@ -419,12 +438,12 @@ pub fn verify<J, P, E>(
     opt: &VerifyOptions,
     joints: &mut J,
     path: &mut P,
-    report: &mut dyn FnMut(&Violation) -> Result<(), E>,
+    report: &mut (dyn FnMut(&Violation) -> Result<(), E> + Send),
 ) -> Result<Summary, E>
 where
-    J: JointSource<Error = E>,
-    P: RowSource<Row = PathPoint, Error = E>,
-    E: From<PairingError>,
+    J: JointSource<Error = E> + Send,
+    P: RowSource<Row = PathPoint, Error = E> + Send,
+    E: From<PairingError> + Send,
 {
     let mut summary = Summary::new();
     summary.timed = joints.timed();
@@ -439,149 +458,162 @@ where
     };
     let mut prev_row: Option<RowEval> = None;
     let mut prev_seg: Option<PrevSeg> = None;
-    let mut batch: Vec<(Paired, bool)> = Vec::with_capacity(BATCH_ROWS);
     let mut gap = false;
-    let mut emit = |v: &Violation, summary: &mut Summary| -> Result<(), E> {
-        summary.add(v);
-        report(v)
-    };
-    loop {
-        batch.clear();
-        let mut done = false;
-        while batch.len() < BATCH_ROWS {
-            match next_pair(&mut pairer, joints, path)? {
-                Some(p) => {
-                    let unpaired = p.point.is_none();
-                    batch.push((p, gap));
-                    gap = unpaired;
-                }
-                None => {
-                    done = true;
-                    break;
-                }
-            }
-        }
-        // Rows in parallel.
-        let rows: Vec<RowEval> = batch
-            .par_iter()
-            .with_min_len(16)
-            .map(|(p, brk)| eval_row(m, opt, p, *brk))
-            .collect();
-        // Segments in parallel: (previous row, row) for every row of the batch.
-        let segs: Vec<Option<SegEval>> = (0..rows.len())
-            .into_par_iter()
-            .with_min_len(16)
-            .map(|k| {
-                let b = &rows[k];
-                let a = if k == 0 {
-                    prev_row.as_ref()
-                } else {
-                    Some(&rows[k - 1])
-                };
-                match a {
-                    Some(a) if a.good && b.good && !b.break_before => {
-                        Some(eval_segment(m, opt, a, b))
+    let mut finished = false;
+    let summary_ref = &mut summary;
+    crate::stream::run_batches::<_, E, _, _, _>(
+        [VerifyBatch::new(), VerifyBatch::new(), VerifyBatch::new()],
+        // Read: pair the next rows of the two inputs, in order.
+        |batch: &mut VerifyBatch| {
+            batch.pairs.clear();
+            while !finished && batch.pairs.len() < BATCH_ROWS {
+                match next_pair(&mut pairer, joints, path)? {
+                    Some(p) => {
+                        let unpaired = p.point.is_none();
+                        batch.pairs.push((p, gap));
+                        gap = unpaired;
                     }
-                    _ => None,
+                    None => finished = true,
                 }
-            })
-            .collect();
-        // In order: accelerations, flip reversals, output.
-        for (k, (row, seg)) in rows.iter().zip(segs).enumerate() {
-            summary.rows += 1;
-            for o in &row.obs {
-                summary.observe(o, &row.label);
             }
-            for v in &row.violations {
-                emit(v, &mut summary)?;
-            }
-            let has_prev = k > 0 || prev_row.is_some();
-            let Some(mut seg) = seg else {
-                if has_prev && !row.break_before {
-                    summary.segments_skipped += 1;
-                }
-                prev_seg = None;
-                continue;
+            Ok(!batch.pairs.is_empty())
+        },
+        // Process: rows and segments in parallel, then the order-dependent checks.
+        |batch: &mut VerifyBatch| {
+            let summary = &mut *summary_ref;
+            batch.findings.clear();
+            let mut emit = |v: &Violation, summary: &mut Summary| -> Result<(), E> {
+                summary.add(v);
+                batch.findings.push(v.clone());
+                Ok(())
             };
-            summary.segments += 1;
-            if seg.dt > 0.0 {
-                // Timed by the joint table, or by the path's feeds.
-                summary.timed = true;
-            }
-            if let (Some(flip), Some(p)) = (seg.flip, &prev_seg)
-                && let Some(pf) = p.flip
-                && pf * flip < 0.0
-                && let Some(v) = seg
-                    .violations
-                    .iter_mut()
-                    .find(|v| v.check == Check::Theta2Flip)
-            {
-                v.detail
-                    .push_str(&format!("; reverses the flip at row {}", p.end_row));
-            }
-            if let (Some(r), Some(p)) = (seg.rates, &prev_seg)
-                && let Some(pr) = p.rates
-            {
-                let amax = opt.thresholds.per_joint(
-                    Th::RhoAccelMmS2,
-                    Th::Theta1AccelDegS2,
-                    Th::Theta2AccelDegS2,
-                );
-                let span = 0.5 * (seg.dt + p.dt);
-                let mut worst = None;
-                for i in 0..5 {
-                    let acc = (r[i] - pr[i]) / span;
-                    let (v, l) = if i < 3 {
-                        (acc.abs(), amax[i])
+            let rows: Vec<RowEval> = batch
+                .pairs
+                .par_iter()
+                .with_min_len(16)
+                .map(|(p, brk)| eval_row(m, opt, p, *brk))
+                .collect();
+            // Segments: (previous row, row) for every row of the batch.
+            let segs: Vec<Option<SegEval>> = (0..rows.len())
+                .into_par_iter()
+                .with_min_len(16)
+                .map(|k| {
+                    let b = &rows[k];
+                    let a = if k == 0 {
+                        prev_row.as_ref()
                     } else {
-                        (acc.abs().to_degrees(), amax[i].to_degrees())
+                        Some(&rows[k - 1])
                     };
-                    keep_worst(
-                        &mut worst,
-                        Obs::over(Check::Acceleration, v, l, JOINT_NAMES[i]),
+                    match a {
+                        Some(a) if a.good && b.good && !b.break_before => {
+                            Some(eval_segment(m, opt, a, b))
+                        }
+                        _ => None,
+                    }
+                })
+                .collect();
+            // In order: accelerations, flip reversals, output.
+            for (k, (row, seg)) in rows.iter().zip(segs).enumerate() {
+                summary.rows += 1;
+                for o in &row.obs {
+                    summary.observe(o, &row.label);
+                }
+                for v in &row.violations {
+                    emit(v, summary)?;
+                }
+                let has_prev = k > 0 || prev_row.is_some();
+                let Some(mut seg) = seg else {
+                    if has_prev && !row.break_before {
+                        summary.segments_skipped += 1;
+                    }
+                    prev_seg = None;
+                    continue;
+                };
+                summary.segments += 1;
+                if seg.dt > 0.0 {
+                    // Timed by the joint table, or by the path's feeds.
+                    summary.timed = true;
+                }
+                if let (Some(flip), Some(p)) = (seg.flip, &prev_seg)
+                    && let Some(pf) = p.flip
+                    && pf * flip < 0.0
+                    && let Some(v) = seg
+                        .violations
+                        .iter_mut()
+                        .find(|v| v.check == Check::Theta2Flip)
+                {
+                    v.detail
+                        .push_str(&format!("; reverses the flip at row {}", p.end_row));
+                }
+                if let (Some(r), Some(p)) = (seg.rates, &prev_seg)
+                    && let Some(pr) = p.rates
+                {
+                    let amax = opt.thresholds.per_joint(
+                        Th::RhoAccelMmS2,
+                        Th::Theta1AccelDegS2,
+                        Th::Theta2AccelDegS2,
                     );
-                    if acc.abs() > amax[i] {
-                        let (v, l, u) = if i < 3 {
-                            (acc.abs(), amax[i], "mm/s^2")
+                    let span = 0.5 * (seg.dt + p.dt);
+                    let mut worst = None;
+                    for i in 0..5 {
+                        let acc = (r[i] - pr[i]) / span;
+                        let (v, l) = if i < 3 {
+                            (acc.abs(), amax[i])
                         } else {
-                            (acc.abs().to_degrees(), amax[i].to_degrees(), "deg/s^2")
+                            (acc.abs().to_degrees(), amax[i].to_degrees())
                         };
-                        seg.violations.push(Violation::over(
-                            &row.label,
-                            Check::Acceleration,
-                            v,
-                            l,
-                            format!(
-                                "{} at {v:.4} {u} between the segments ending at rows {} and {}",
-                                JOINT_NAMES[i], p.end_row, row.label
-                            ),
-                        ));
+                        keep_worst(
+                            &mut worst,
+                            Obs::over(Check::Acceleration, v, l, JOINT_NAMES[i]),
+                        );
+                        if acc.abs() > amax[i] {
+                            let (v, l, u) = if i < 3 {
+                                (acc.abs(), amax[i], "mm/s^2")
+                            } else {
+                                (acc.abs().to_degrees(), amax[i].to_degrees(), "deg/s^2")
+                            };
+                            seg.violations.push(Violation::over(
+                                &row.label,
+                                Check::Acceleration,
+                                v,
+                                l,
+                                format!(
+                                    "{} at {v:.4} {u} between the segments ending at rows {} and {}",
+                                    JOINT_NAMES[i], p.end_row, row.label
+                                ),
+                            ));
+                        }
+                    }
+                    if let Some(o) = worst {
+                        summary.observe(&o, &row.label);
                     }
                 }
-                if let Some(o) = worst {
-                    summary.observe(&o, &row.label);
+                for o in &seg.obs {
+                    summary.observe(o, &row.label);
                 }
+                for v in &seg.violations {
+                    emit(v, summary)?;
+                }
+                prev_seg = Some(PrevSeg {
+                    end_row: row.label.clone(),
+                    rates: seg.rates,
+                    dt: seg.dt,
+                    flip: seg.flip,
+                });
             }
-            for o in &seg.obs {
-                summary.observe(o, &row.label);
+            if let Some(last) = rows.into_iter().last() {
+                prev_row = Some(last);
             }
-            for v in &seg.violations {
-                emit(v, &mut summary)?;
+            Ok(())
+        },
+        // Write: the findings, in row order.
+        |batch: &mut VerifyBatch| {
+            for v in &batch.findings {
+                report(v)?;
             }
-            prev_seg = Some(PrevSeg {
-                end_row: row.label.clone(),
-                rates: seg.rates,
-                dt: seg.dt,
-                flip: seg.flip,
-            });
-        }
-        if let Some(last) = rows.into_iter().last() {
-            prev_row = Some(last);
-        }
-        if done {
-            break;
-        }
-    }
+            Ok(())
+        },
+    )?;
     // Intended rows never matched by a joint row.
     if let Pairer::ById {
         pending, path_done, ..
@@ -605,7 +637,8 @@ where
                     item.line
                 ),
             );
-            emit(&v, &mut summary)?;
+            summary.add(&v);
+            report(&v)?;
         }
     }
     Ok(summary)
