@@ -11,17 +11,31 @@ use csv::ByteRecord;
 use verne::error::shown;
 
 use crate::error::VerneError;
+use crate::input::rows::{FieldRow, FieldRows};
 
-/// A CSV input with a header row (file or stdin).
+/// A table input with a header: CSV text (a file or stdin), or the rows of a reader of another
+/// format in the same columns ([`FieldRows`]).
 pub struct CsvSource {
-    reader: csv::Reader<Box<dyn Read + Send>>,
+    records: Records,
     name: String,
     headers: ByteRecord,
-    /// The record as read, before its fields are trimmed into the caller's record.
-    raw: ByteRecord,
-    /// A column that holds each row's line in the file the rows come from (a CL file read as
-    /// CSV): messages then name that line rather than the line of the CSV text.
+    /// A column that holds each row's line in the file the rows come from (a CL file's rows):
+    /// messages then name that line rather than the row's place in the table.
     line_column: Option<usize>,
+}
+
+/// Where the records of a [`CsvSource`] come from.
+enum Records {
+    Text {
+        reader: csv::Reader<Box<dyn Read + Send>>,
+        /// The record as read, before its fields are trimmed into the caller's record.
+        raw: ByteRecord,
+    },
+    Fields {
+        rows: Box<dyn FieldRows>,
+        /// Scratch space for formatting a field.
+        text: Vec<u8>,
+    },
 }
 
 impl CsvSource {
@@ -73,14 +87,33 @@ impl CsvSource {
             headers_clean.push_field(h);
         }
         let src = CsvSource {
-            reader,
+            records: Records::Text {
+                reader,
+                raw: ByteRecord::new(),
+            },
             name: name.to_string(),
             headers: headers_clean,
-            raw: ByteRecord::new(),
             line_column: None,
         };
         src.check_duplicate_headers()?;
         Ok(src)
+    }
+
+    /// The rows of a reader of another format, record by record (no CSV text in between);
+    /// messages take each row's line from its `line` column. `name` is the reader's input.
+    pub fn from_rows(rows: Box<dyn FieldRows>, name: &str) -> CsvSource {
+        let headers = ByteRecord::from(rows.header().to_vec());
+        let mut src = CsvSource {
+            records: Records::Fields {
+                rows,
+                text: Vec::with_capacity(32),
+            },
+            name: name.to_string(),
+            headers,
+            line_column: None,
+        };
+        src.line_column = src.column("line");
+        src
     }
 
     fn check_duplicate_headers(&self) -> Result<(), VerneError> {
@@ -171,7 +204,15 @@ impl CsvSource {
     /// Reads the next record into `rec`; false at the end of the input.
     /// Every field has its surrounding ASCII white space removed.
     pub fn read(&mut self, rec: &mut ByteRecord) -> Result<bool, VerneError> {
-        match self.reader.read_byte_record(&mut self.raw) {
+        let (reader, raw) = match &mut self.records {
+            Records::Text { reader, raw } => (reader, raw),
+            Records::Fields { rows, text } => {
+                return rows
+                    .next_row(&mut FieldRow::new(rec, text))
+                    .map_err(|e| VerneError::io(&self.name, e));
+            }
+        };
+        match reader.read_byte_record(raw) {
             Ok(true) => {}
             Ok(false) => return Ok(false),
             Err(e) => return Err(csv_error(&self.name, e)),
@@ -180,14 +221,14 @@ impl CsvSource {
             f.first().is_some_and(u8::is_ascii_whitespace)
                 || f.last().is_some_and(u8::is_ascii_whitespace)
         };
-        if self.raw.iter().any(padded) {
+        if raw.iter().any(padded) {
             rec.clear();
-            rec.set_position(self.raw.position().cloned());
-            for f in self.raw.iter() {
+            rec.set_position(raw.position().cloned());
+            for f in raw.iter() {
                 rec.push_field(f.trim_ascii());
             }
         } else {
-            std::mem::swap(rec, &mut self.raw);
+            std::mem::swap(rec, raw);
         }
         Ok(true)
     }

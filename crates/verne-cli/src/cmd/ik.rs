@@ -13,9 +13,8 @@ use verne::spec::Machine;
 
 use super::{Mechanism, inline_source, load_mechanism, refuse_for_glider, run_rows, units};
 use crate::cli::{IkArgs, OutputFormat, Prefer};
-use crate::input::as_csv::AsCsv;
-use crate::input::cl::{ClAsCsv, ClRows, PathInput, open_path_input, report_summary};
-use crate::input::gcode::{TcpAsCsv, TcpRows};
+use crate::input::cl::{ClRows, PathInput, open_path_input, report_summary};
+use crate::input::gcode::TcpRows;
 use crate::input::resample::{CsvPoses, Resampler};
 
 pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
@@ -69,9 +68,9 @@ pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
         // A program's poses straight from its reader, angle words and all.
         (Some(period), Source::Program(rows, name)) => {
             let rows = Resampler::new(rows, period, args.rapid, args.common.radians);
-            CsvSource::from_reader(Box::new(AsCsv::new(rows)), &name)?.with_line_column("line")
+            CsvSource::from_rows(Box::new(rows), &name)
         }
-        (None, program @ Source::Program(..)) => program.into_csv()?,
+        (None, program @ Source::Program(..)) => program.into_rows(),
         (Some(period), Source::Csv(source)) => {
             if source.column("xp").is_some() && source.column("x").is_none() {
                 return Err(VerneError::Usage(
@@ -81,7 +80,7 @@ pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
             let name = source.name().to_string();
             let poses = CsvPoses::new(source, args.common.radians)?;
             let rows = Resampler::new(Box::new(poses), period, args.rapid, args.common.radians);
-            CsvSource::from_reader(Box::new(AsCsv::new(rows)), &name)?.with_line_column("line")
+            CsvSource::from_rows(Box::new(rows), &name)
         }
         (None, Source::Csv(source)) => source,
     };
@@ -172,25 +171,19 @@ type Summaries = (
     Option<(Arc<Mutex<verne_gcode::Summary>>, String)>,
 );
 
-/// The rows of `verne ik` as CSV: inline poses, a CSV, a CL file or a G-code program (with the
-/// reader's summary, shared, to print at the end).
-/// The input of `verne ik`: rows as CSV, or a tool-centre program's poses (read as CSV text
-/// by the row engine, or straight from the reader by `--period`).
+/// The input of `verne ik`: a table (inline poses, a CSV, a CL file's rows), or a tool-centre
+/// program's poses (its rows for the row engine, or its poses for `--period`).
 enum Source {
     Csv(CsvSource),
     Program(Box<TcpRows>, String),
 }
 
 impl Source {
-    /// The input as CSV rows (a program's poses as `TcpRows` writes them).
-    fn into_csv(self) -> Result<CsvSource, VerneError> {
+    /// The input as a table (a program's poses in the columns of [`TcpRows`]).
+    fn into_rows(self) -> CsvSource {
         match self {
-            Source::Csv(src) => Ok(src),
-            Source::Program(rows, name) => Ok(CsvSource::from_reader(
-                Box::new(TcpAsCsv::new(*rows)),
-                &name,
-            )?
-            .with_line_column("line")),
+            Source::Csv(src) => src,
+            Source::Program(rows, name) => CsvSource::from_rows(rows, &name),
         }
     }
 }
@@ -219,8 +212,10 @@ fn open_source(args: &IkArgs, machine: &Machine) -> Result<(Source, Summaries), 
             PathInput::Cl(reader, name) => {
                 let rows = ClRows::new(*reader);
                 let summary = Some((rows.summary(), name.clone()));
-                let src = CsvSource::from_reader(Box::new(ClAsCsv::new(rows)), &name)?;
-                (Source::Csv(src.with_line_column("line")), (summary, None))
+                (
+                    Source::Csv(CsvSource::from_rows(Box::new(rows), &name)),
+                    (summary, None),
+                )
             }
         },
     )
@@ -245,7 +240,7 @@ fn prescan_theta2(
     if !rereadable {
         return Ok(None);
     }
-    let mut src = open_source(args, machine)?.0.into_csv()?;
+    let mut src = open_source(args, machine)?.0.into_rows();
     let col = |c: &str| src.column(c);
     let (Some(x), Some(y), Some(z)) = (col("x"), col("y"), col("z")) else {
         return Ok(None);

@@ -223,8 +223,7 @@ impl<S: Default> Batch<S> {
     /// Most rows a batch of this job reads: [`BATCH_ROWS`], fewer when its rows are large
     /// ([`BATCH_BYTES`]).
     fn max_rows() -> usize {
-        let rows = (BATCH_BYTES / size_of::<PendingRow<S>>().max(1)).clamp(RUN_ROWS, BATCH_ROWS);
-        rows / RUN_ROWS * RUN_ROWS
+        (BATCH_BYTES / size_of::<PendingRow<S>>().max(1)).clamp(RUN_ROWS, BATCH_ROWS)
     }
 
     fn new() -> Batch<S> {
@@ -238,13 +237,11 @@ impl<S: Default> Batch<S> {
         }
     }
 
-    /// Reads up to `rows` records (rounded down to whole runs of [`RUN_ROWS`], so that runs start
-    /// at the same rows whatever the batch sizes), reusing the rows in place (a row can hold a solver's
+    /// Reads up to `rows` records, reusing the rows in place (a row can hold a solver's
     /// fixed-capacity result, a kilobyte or more: moving rows would cost more than solving).
     fn fill(&mut self, source: &mut CsvSource, rows: usize) -> Result<(), VerneError> {
         self.filled = 0;
         self.encoded_runs = 0;
-        let rows = (rows / RUN_ROWS).max(1) * RUN_ROWS;
         while self.filled < rows {
             if self.filled == self.rows.len() {
                 self.rows.push(PendingRow {
@@ -365,14 +362,18 @@ fn stream_batches<J: RowJob>(
     progress: Progress<'_>,
 ) -> Result<RunSummary, VerneError> {
     let mut summary = RunSummary::default();
-    // Rows per batch, from the output rows per input row of the last batch solved. The first
-    // batch is small: its output rows per input row size the next ones.
-    let batch_rows = AtomicUsize::new(RUN_ROWS);
+    // Rows per batch, from the output rows per input row of a batch solved: the first batch is
+    // small, and batch k + 2 is sized by batch k (solved while batch k + 1 is read). The size
+    // goes through one slot per parity of k, so that a read never sees a value stored while it
+    // runs: the batches, and so the runs, are the same from run to run.
+    let sizes = [AtomicUsize::new(RUN_ROWS), AtomicUsize::new(RUN_ROWS)];
+    let (mut reads, mut solved) = (0usize, 0usize);
     let max_rows = Batch::<J::Solved>::max_rows();
     verne::stream::run_batches(
         [Batch::new(), Batch::new(), Batch::new()],
         |batch: &mut Batch<J::Solved>| {
-            batch.fill(source, batch_rows.load(Ordering::Relaxed))?;
+            batch.fill(source, sizes[reads % 2].load(Ordering::Relaxed))?;
+            reads += 1;
             Ok(batch.filled > 0)
         },
         |batch: &mut Batch<J::Solved>| {
@@ -380,7 +381,8 @@ fn stream_batches<J: RowJob>(
             progress(summary.input_rows);
             let per_input = batch.out_input.len().div_ceil(batch.filled.max(1)).max(1);
             let rows = (BATCH_OUTPUT_ROWS / per_input).clamp(RUN_ROWS, max_rows);
-            batch_rows.store(rows, Ordering::Relaxed);
+            sizes[solved % 2].store(rows, Ordering::Relaxed);
+            solved += 1;
             Ok(())
         },
         |batch: &mut Batch<J::Solved>| batch.write(sink),

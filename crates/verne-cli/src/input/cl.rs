@@ -1,7 +1,7 @@
 //! CL (cutter-location / APT source) files in the CLI: the reader is the `verne-cl` crate
 //! (every dialect of `docs/cl-dialects.md`: NX CLSF and listings, Creo, SolidWorks CAM, CATIA,
 //! generic APT; units, arcs, cycles, feeds, tools). Here: opening a file or stdin with the
-//! file's name on every error, the rows as CSV text for the row engine of `verne ik`, and the
+//! file's name on every error, the rows in CSV columns for the row engine of `verne ik`, and the
 //! summary (warnings, skipped records) on stderr.
 
 use std::io::{BufRead, Read, Seek, Write};
@@ -12,8 +12,8 @@ use verne_cl::{ClError, Options, Reader, Summary};
 
 use crate::cli::InputFormat;
 use crate::error::VerneError;
-use crate::input::as_csv::{AsCsv, CsvRows, invalid_data};
 use crate::input::gcode::{GcodeReader, gcode_error};
+use crate::input::rows::{FieldRow, FieldRows, invalid_data};
 use crate::table::CsvSource;
 
 /// A CL error as the CLI's input error: file, line, column, what was expected.
@@ -238,16 +238,13 @@ fn shortened(items: &[String], n: usize) -> String {
     format!("{}, and {} more", items[..n].join(", "), items.len() - n)
 }
 
-/// A CL file read as CSV text (`line,kind,motion,feed,tool,x,y,z,i,j,k`, mm, unit axis), so
+/// A CL file's rows in the columns `line,kind,motion,feed,tool,x,y,z,i,j,k` (mm, unit axis), so
 /// that `verne ik` streams it through the same row engine as a CSV file. The reader's summary
 /// is shared through [`ClRows::summary`] and complete once the text has been read to its end.
 pub struct ClRows {
     reader: ClReader,
     summary: Arc<Mutex<Summary>>,
 }
-
-/// [`ClRows`] as CSV text.
-pub type ClAsCsv = AsCsv<ClRows>;
 
 impl ClRows {
     /// The rows of `reader`.
@@ -262,28 +259,24 @@ impl ClRows {
     }
 }
 
-impl CsvRows for ClRows {
-    fn header(&self) -> &'static [u8] {
-        b"line,kind,motion,feed,tool,x,y,z,i,j,k\n"
+impl FieldRows for ClRows {
+    fn header(&self) -> &'static [&'static str] {
+        &[
+            "line", "kind", "motion", "feed", "tool", "x", "y", "z", "i", "j", "k",
+        ]
     }
 
-    fn next_row(&mut self, buf: &mut Vec<u8>) -> std::io::Result<bool> {
+    fn next_row(&mut self, row: &mut FieldRow<'_>) -> std::io::Result<bool> {
         match self.reader.next() {
             Some(Ok(r)) => {
-                let (t, a) = (r.tip, r.axis);
-                write!(buf, "{},{},{},", r.line, r.kind, r.motion.as_str())?;
-                if let Some(f) = r.feed_mm_min {
-                    write!(buf, "{f}")?;
+                row.field(r.line);
+                row.field(r.kind);
+                row.field(r.motion.as_str());
+                row.optional(r.feed_mm_min);
+                row.optional(r.tool);
+                for v in r.tip.iter().chain(&r.axis) {
+                    row.field(v);
                 }
-                buf.push(b',');
-                if let Some(n) = r.tool {
-                    write!(buf, "{n}")?;
-                }
-                writeln!(
-                    buf,
-                    ",{},{},{},{},{},{}",
-                    t[0], t[1], t[2], a[0], a[1], a[2]
-                )?;
                 Ok(true)
             }
             Some(Err(e)) => Err(invalid_data(e.to_string())),

@@ -20,8 +20,8 @@ use verne::verify::{Item, JointSource, Joints, PathPoint, RowSource};
 use verne_gcode::{AXES, Axis, GcodeError, Motion, Options, Reader, Row, Summary};
 
 use crate::error::VerneError;
-use crate::input::as_csv::{AsCsv, CsvRows, invalid_data};
 use crate::input::resample::{PathPose, PoseStream};
+use crate::input::rows::{FieldRow, FieldRows, invalid_data};
 
 /// A G-code reader over a boxed input, as the CLI reads files and stdin alike.
 pub type GcodeReader = Reader<Box<dyn BufRead + Send>>;
@@ -193,47 +193,35 @@ impl TcpRows {
     }
 }
 
-impl CsvRows for TcpRows {
-    fn header(&self) -> &'static [u8] {
-        b"line,n,kind,motion,feed,dt,tool,x,y,z,i,j,k\n"
+impl FieldRows for TcpRows {
+    fn header(&self) -> &'static [&'static str] {
+        &[
+            "line", "n", "kind", "motion", "feed", "dt", "tool", "x", "y", "z", "i", "j", "k",
+        ]
     }
 
-    fn next_row(&mut self, buf: &mut Vec<u8>) -> std::io::Result<bool> {
-        match self.next_pose_or_end()? {
-            None => Ok(false),
-            Some(p) => {
-                let r = &p.row;
-                write!(buf, "{},", r.line)?;
-                if let Some(n) = r.n {
-                    write!(buf, "N{n}")?;
-                }
-                write!(buf, ",{},{},", r.kind.as_str(), r.motion.as_str())?;
-                if let Some(f) = r.feed_per_min.filter(|_| r.motion == Motion::Feed) {
-                    write!(buf, "{f}")?;
-                }
-                buf.push(b',');
-                // The time of the move as the program states it (its feed, G93), s.
-                if let Some(d) = r.duration_s {
-                    write!(buf, "{d}")?;
-                }
-                buf.push(b',');
-                if let Some(t) = r.tool {
-                    write!(buf, "{t}")?;
-                }
-                let (t, a) = (p.tip, p.axis);
-                writeln!(
-                    buf,
-                    ",{},{},{},{},{},{}",
-                    t[0], t[1], t[2], a[0], a[1], a[2]
-                )?;
-                Ok(true)
-            }
+    fn next_row(&mut self, row: &mut FieldRow<'_>) -> std::io::Result<bool> {
+        let Some(p) = self.next_pose_or_end()? else {
+            return Ok(false);
+        };
+        let r = &p.row;
+        row.field(r.line);
+        row.optional(r.n.map(|n| format!("N{n}")));
+        row.field(r.kind.as_str());
+        row.field(r.motion.as_str());
+        row.optional(r.feed_per_min.filter(|_| r.motion == Motion::Feed));
+        // The time of the move as the program states it (its feed, G93), s.
+        row.optional(r.duration_s);
+        row.optional(r.tool);
+        for v in p.tip.iter().chain(&p.axis) {
+            row.field(v);
         }
+        Ok(true)
     }
 }
 
 impl TcpRows {
-    /// The next pose, `None` at the end; an error as the CSV view reports it (the view names
+    /// The next pose, `None` at the end; an error as the row engine reports it (it names
     /// the file itself), and a program without a move is an error.
     fn next_pose_or_end(&mut self) -> std::io::Result<Option<TcpPose>> {
         match self.next_pose() {
@@ -293,9 +281,6 @@ impl PoseStream for TcpRows {
         }))
     }
 }
-
-/// [`TcpRows`] as CSV text for `verne ik`.
-pub type TcpAsCsv = AsCsv<TcpRows>;
 
 /// A tool-centre program as the intended path of `verne verify`.
 pub struct TcpPath {

@@ -3,11 +3,11 @@
 //! ([`recording`]). CSV reading itself is in
 //! [`crate::table`].
 
-pub mod as_csv;
 pub mod cl;
 pub mod gcode;
 pub mod recording;
 pub mod resample;
+pub mod rows;
 pub mod verify_files;
 
 /// A reader's warnings on stderr, `verne CMD: NAME: warning: ...`, and how many it stopped

@@ -8,18 +8,15 @@
 //! (`verne::machine::orientation::move_angles`: as the input states them, or from the axes), and
 //! each sample is then solved by the inverse kinematics like any row.
 
-use std::io::{self, Write};
+use std::io;
 
 use csv::ByteRecord;
 use nalgebra::Vector3;
 use verne::machine::orientation::{move_angles, tool_axis};
 
 use crate::error::VerneError;
-use crate::input::as_csv::{CsvRows, invalid_data};
+use crate::input::rows::{FieldRow, FieldRows, invalid_data};
 use crate::table::{CsvSource, parse_number};
-
-/// Most samples written per call (the rest of a long move is written on the next calls).
-const SAMPLES_PER_CALL: u64 = 1024;
 
 #[derive(Clone, Copy)]
 enum Orientation {
@@ -262,14 +259,23 @@ impl Resampler {
         Ok(60.0 * per_minute / rate)
     }
 
-    fn write_sample(&self, out: &mut Vec<u8>, line: &str, t: f64, p: &Pose) -> io::Result<()> {
-        write!(out, "{line},{t:.6},{},{},{},", p.tip.x, p.tip.y, p.tip.z)?;
+    fn write_sample(&self, row: &mut FieldRow<'_>, line: &str, t: f64, p: &Pose) {
+        row.field(line);
+        row.field(format_args!("{t:.6}"));
+        for v in p.tip.iter() {
+            row.field(v);
+        }
         match (self.angles_out, p.angles) {
             (Some(radians), Some((p1, p2))) => {
                 let unit = |v: f64| if radians { v } else { v.to_degrees() };
-                writeln!(out, "{},{}", unit(p1), unit(p2))
+                row.field(unit(p1));
+                row.field(unit(p2));
             }
-            _ => writeln!(out, "{},{},{}", p.axis.x, p.axis.y, p.axis.z),
+            _ => {
+                for v in p.axis.iter() {
+                    row.field(v);
+                }
+            }
         }
     }
 }
@@ -299,35 +305,28 @@ fn between(a: &Pose, b: &Pose, s: f64) -> Pose {
     }
 }
 
-impl CsvRows for Resampler {
-    fn header(&self) -> &'static [u8] {
+impl FieldRows for Resampler {
+    fn header(&self) -> &'static [&'static str] {
         if self.angles_out.is_some() {
-            b"line,t,x,y,z,phi1,phi2\n"
+            &["line", "t", "x", "y", "z", "phi1", "phi2"]
         } else {
-            b"line,t,x,y,z,i,j,k\n"
+            &["line", "t", "x", "y", "z", "i", "j", "k"]
         }
     }
 
-    fn next_row(&mut self, out: &mut Vec<u8>) -> io::Result<bool> {
+    fn next_row(&mut self, out: &mut FieldRow<'_>) -> io::Result<bool> {
         loop {
             if let Some(m) = &self.current {
-                let mut written = 0;
-                while written < SAMPLES_PER_CALL {
-                    let t = self.tick as f64 * self.period;
-                    if t > m.t1 + 1e-9 * self.period {
-                        break;
-                    }
+                let t = self.tick as f64 * self.period;
+                if t <= m.t1 + 1e-9 * self.period {
                     let s = if m.t1 > m.t0 {
                         ((t - m.t0) / (m.t1 - m.t0)).clamp(0.0, 1.0)
                     } else {
                         1.0
                     };
                     let p = between(&m.a, &m.b, s);
-                    self.write_sample(out, &m.line, t, &p)?;
+                    self.write_sample(out, &m.line, t, &p);
                     self.tick += 1;
-                    written += 1;
-                }
-                if written > 0 {
                     return Ok(true);
                 }
                 self.current = None;
@@ -344,7 +343,7 @@ impl CsvRows for Resampler {
                         && self.tick > 0
                         && ((self.tick - 1) as f64 * self.period) < t - 1e-9 * self.period
                     {
-                        self.write_sample(out, &line, t, &p)?;
+                        self.write_sample(out, &line, t, &p);
                         return Ok(true);
                     }
                     return Ok(false);
