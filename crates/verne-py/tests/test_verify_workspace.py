@@ -92,6 +92,12 @@ def test_workspace_is_verne_workspace():
     assert a["volume_lo_mm3"] <= u["volume_mm3"] <= a["volume_hi_mm3"]
     assert a["inside"] == u["inside"]
     assert str(a["classified"]) in text.replace(",", "")
+    # The boundary sample: the CLI's estimate, inside the bracket.
+    assert a["volume_lo_mm3"] <= a["volume_sampled_mm3"] <= a["volume_hi_mm3"]
+    assert 0 < a["sampled_cells"] <= a["boundary_cells"]
+    assert math.isclose(
+        a["volume_sampled_mm3"] * 1e-6, summary_number(text, r"boundary sampled\s+([\d.]+) l"), abs_tol=1e-4
+    )
     with pytest.raises(ValueError, match="adaptive=False"):
         verne.workspace(M, step=2, points=True)
     with pytest.raises(ValueError, match="of="):

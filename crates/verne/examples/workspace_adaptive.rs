@@ -21,7 +21,7 @@ fn main() {
     }
     let m = Machine::default_verne();
     println!(
-        "step_mm,classified,lattice_points,seconds,volume_l,bracket_lo_l,bracket_hi_l,error_bound_pct,uniform_inside,adaptive_inside,uniform_seconds"
+        "step_mm,classified,lattice_points,seconds,volume_l,bracket_lo_l,bracket_hi_l,error_bound_pct,sampled_l,sampled_half_width_pct,sampled_cells,uniform_inside,adaptive_inside,uniform_seconds"
     );
     for step in steps {
         let opts = WorkspaceOptions {
@@ -47,13 +47,16 @@ fn main() {
             (String::new(), String::new())
         };
         println!(
-            "{step},{},{},{secs:.2},{:.4},{:.4},{:.4},{:.3},{ui},{},{us}",
+            "{step},{},{},{secs:.2},{:.4},{:.4},{:.4},{:.3},{:.4},{:.4},{},{ui},{},{us}",
             a.classified,
             a.lattice_points,
             a.volume_mm3 * 1e-6,
             a.volume_lo_mm3 * 1e-6,
             a.volume_hi_mm3 * 1e-6,
             100.0 * a.error_bound_mm3() / a.volume_mm3,
+            a.volume_sampled_mm3 * 1e-6,
+            100.0 * a.sampled_half_width_mm3 / a.volume_sampled_mm3,
+            a.sampled_cells,
             a.inside_points
         );
     }

@@ -336,3 +336,74 @@ fn bad_options_are_refused() {
         workspace::compute_adaptive(&m, &options(Of::Platform, 0.0, 1e-9), 8, &|_| {}).is_err()
     );
 }
+
+/// The boundary cells' sample (workspace/adaptive.rs): its estimate inside the bracket and its
+/// interval narrower, at two steps; and the finer estimate against an independent slow method,
+/// points drawn uniformly in the whole box and classified one by one (no cell, no assumption
+/// that a cell with agreeing corners is all inside or all outside).
+#[test]
+fn the_sampled_volume_agrees_with_uniform_random_points() {
+    let m = Machine::default_verne();
+    let coarse =
+        workspace::compute_adaptive(&m, &options(Of::Platform, 0.0, 20.0), 8, &|_| {}).unwrap();
+    let fine =
+        workspace::compute_adaptive(&m, &options(Of::Platform, 0.0, 5.0), 8, &|_| {}).unwrap();
+    for a in [&coarse, &fine] {
+        let name = format!("{} mm", a.step);
+        assert!(
+            a.sampled_cells > 1000 && a.sampled_cells <= a.boundary_cells,
+            "{name}: {} of {} boundary cells sampled",
+            a.sampled_cells,
+            a.boundary_cells
+        );
+        assert!(
+            a.volume_lo_mm3 <= a.volume_sampled_mm3 && a.volume_sampled_mm3 <= a.volume_hi_mm3,
+            "{name}: the estimate is in the bracket"
+        );
+        assert!(
+            a.sampled_half_width_mm3 > 0.0 && a.sampled_half_width_mm3 < 0.1 * a.error_bound_mm3(),
+            "{name}: half-width {} against the bracket's {}",
+            a.sampled_half_width_mm3,
+            a.error_bound_mm3()
+        );
+    }
+    let (c, f) = (&coarse, &fine);
+    assert!(
+        (c.volume_sampled_mm3 - f.volume_sampled_mm3).abs()
+            <= c.sampled_half_width_mm3 + f.sampled_half_width_mm3,
+        "20 mm: {} +- {}, 5 mm: {} +- {}",
+        c.volume_sampled_mm3,
+        c.sampled_half_width_mm3,
+        f.volume_sampled_mm3,
+        f.sampled_half_width_mm3
+    );
+    // 400,000 points uniform in the default box (a fixed LCG), each classified.
+    let opts = options(Of::Platform, 0.0, 5.0);
+    let b = workspace::default_bounds(&m, Of::Platform, 0.0);
+    let mut state = 0x2545_F491_4F6C_DD1Du64;
+    let mut next = || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let n = 400_000u64;
+    let mut inside = 0u64;
+    for _ in 0..n {
+        let p =
+            b.min + (b.max - b.min).component_mul(&nalgebra::Vector3::new(next(), next(), next()));
+        if workspace::classify(&m, &opts, &p).outcome == Outcome::Inside {
+            inside += 1;
+        }
+    }
+    let box_mm3 = (b.max - b.min).product();
+    let mc = inside as f64 / n as f64 * box_mm3;
+    let delta = workspace::SAMPLED_CONFIDENCE_DELTA;
+    let mc_half = ((2.0 / delta).ln() / (2.0 * n as f64)).sqrt() * box_mm3;
+    assert!(
+        (f.volume_sampled_mm3 - mc).abs() <= f.sampled_half_width_mm3 + mc_half,
+        "5 mm: {} +- {}, random points: {mc} +- {mc_half}",
+        f.volume_sampled_mm3,
+        f.sampled_half_width_mm3
+    );
+}

@@ -104,6 +104,8 @@ fn run_sweep(
             "volume_l",
             "bracket_lo_l",
             "bracket_hi_l",
+            "sampled_l",
+            "sampled_half_width_l",
             "xmin",
             "xmax",
             "ymin",
@@ -134,6 +136,8 @@ fn run_sweep(
         row.push(format!("{:.4}", a.volume_mm3 * 1e-6));
         row.push(format!("{:.4}", a.volume_lo_mm3 * 1e-6));
         row.push(format!("{:.4}", a.volume_hi_mm3 * 1e-6));
+        row.push(format!("{:.4}", a.volume_sampled_mm3 * 1e-6));
+        row.push(format!("{:.4}", a.sampled_half_width_mm3 * 1e-6));
         match a.bbox {
             Some(b) => {
                 for d in 0..3 {
@@ -233,6 +237,15 @@ fn run_adaptive(
                 0.0
             }
         );
+        if a.sampled_cells > 0 {
+            let _ = writeln!(
+                text,
+                "  boundary sampled   {:.4} l +- {:.4} % (99.7 % confidence, Hoeffding): one pseudo-random point in each of {} boundary cells",
+                a.volume_sampled_mm3 * 1e-6,
+                100.0 * a.sampled_half_width_mm3 / a.volume_sampled_mm3.max(f64::MIN_POSITIVE),
+                a.sampled_cells
+            );
+        }
         let _ = writeln!(
             text,
             "  points classified  {} of {} lattice points ({:.2} %), {secs:.1} s",

@@ -41,7 +41,10 @@ use crate::par::*;
 use crate::parallel_module::equations::{ModulePose, Sliders};
 use crate::spec::Machine;
 
-pub use adaptive::{AdaptiveSummary, DEFAULT_COARSE_FACTOR, compute_adaptive};
+pub use adaptive::{
+    AdaptiveSummary, BOUNDARY_SAMPLES, DEFAULT_COARSE_FACTOR, SAMPLED_CONFIDENCE_DELTA,
+    compute_adaptive,
+};
 pub use classify::{ALPHA_MATCH_RAD, classify, grid_point_of, manufacturing_tip, tool_tip};
 pub use grid::{Bounds, Grid, GridBox, MAX_GRID_POINTS, default_bounds, grid_for, round_bounds};
 pub use largest_box::largest_box;
