@@ -209,6 +209,32 @@ fn a_sweep_row_is_the_workspace_of_that_machine() {
         .and_then(|l| l.split_whitespace().nth(1))
         .unwrap();
     assert_eq!(rows[1][1], volume, "{summary}");
+    // And its largest box and bound, by the header's names.
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let cell = |name: &str| rows[1][header.iter().position(|h| *h == name).unwrap()];
+    let box_line = summary
+        .lines()
+        .find(|l| l.trim_start().starts_with("largest box"))
+        .unwrap();
+    let litres = |after: &str| {
+        let rest = &box_line[box_line.find(after).unwrap() + after.len()..];
+        rest.split_whitespace()
+            .next()
+            .unwrap()
+            .parse::<f64>()
+            .unwrap()
+    };
+    let close = |a: &str, b: f64| (a.parse::<f64>().unwrap() - b).abs() < 1e-3;
+    assert!(close(cell("largest_box_l"), litres("mm = ")), "{box_line}");
+    assert!(
+        close(cell("largest_box_upper_l"), litres("larger than ")),
+        "{box_line}"
+    );
+    assert!(
+        cell("largest_box_l").parse::<f64>().unwrap() > 0.0
+            && cell("box_xmin").parse::<f64>().unwrap() < cell("box_xmax").parse::<f64>().unwrap(),
+        "{text}"
+    );
     // L1 = 800 as a machine file over the default gives the same as its row.
     let dir = std::env::temp_dir().join(format!("verne-sweep-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();

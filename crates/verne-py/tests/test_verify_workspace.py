@@ -92,6 +92,12 @@ def test_workspace_is_verne_workspace():
     assert a["volume_lo_mm3"] <= u["volume_mm3"] <= a["volume_hi_mm3"]
     assert a["inside"] == u["inside"]
     assert str(a["classified"]) in text.replace(",", "")
+    # The largest box: no larger than the uniform grid's exhaustive one, which is within the bound.
+    best = u["largest_box"]["volume_mm3"]
+    assert a["largest_box"]["volume_mm3"] <= best <= a["largest_box"]["upper_bound_mm3"]
+    assert math.isclose(
+        a["largest_box"]["volume_mm3"] * 1e-6, summary_number(text, r"mm = ([\d.]+) l \(no box"), abs_tol=1e-3
+    )
     # The boundary sample: the CLI's estimate, inside the bracket.
     assert a["volume_lo_mm3"] <= a["volume_sampled_mm3"] <= a["volume_hi_mm3"]
     assert 0 < a["sampled_cells"] <= a["boundary_cells"]

@@ -21,7 +21,7 @@ fn main() {
     }
     let m = Machine::default_verne();
     println!(
-        "step_mm,classified,lattice_points,seconds,volume_l,bracket_lo_l,bracket_hi_l,error_bound_pct,sampled_l,sampled_half_width_pct,sampled_cells,uniform_inside,adaptive_inside,uniform_seconds"
+        "step_mm,classified,lattice_points,seconds,volume_l,bracket_lo_l,bracket_hi_l,error_bound_pct,sampled_l,sampled_half_width_pct,sampled_cells,largest_box_l,largest_box_upper_l,box_points,uniform_inside,adaptive_inside,uniform_seconds"
     );
     for step in steps {
         let opts = WorkspaceOptions {
@@ -39,15 +39,16 @@ fn main() {
             let u = compute(&m, &opts, &|_| {}, |_| Ok::<(), ()>(()))
                 .unwrap()
                 .unwrap();
+            let best = u.summary.largest_box_size().map_or(0.0, |b| b.1 * 1e-6);
             (
-                u.summary.inside.to_string(),
+                format!("{} (largest box {best:.4} l)", u.summary.inside),
                 format!("{:.2}", t.elapsed().as_secs_f64()),
             )
         } else {
             (String::new(), String::new())
         };
         println!(
-            "{step},{},{},{secs:.2},{:.4},{:.4},{:.4},{:.3},{:.4},{:.4},{},{ui},{},{us}",
+            "{step},{},{},{secs:.2},{:.4},{:.4},{:.4},{:.3},{:.4},{:.4},{},{:.4},{:.4},{},{ui},{},{us}",
             a.classified,
             a.lattice_points,
             a.volume_mm3 * 1e-6,
@@ -57,6 +58,9 @@ fn main() {
             a.volume_sampled_mm3 * 1e-6,
             100.0 * a.sampled_half_width_mm3 / a.volume_sampled_mm3,
             a.sampled_cells,
+            a.largest_box_mm3 * 1e-6,
+            a.largest_box_upper_mm3 * 1e-6,
+            a.box_points_classified,
             a.inside_points
         );
     }

@@ -263,10 +263,10 @@ fn a_zero_length_tool_has_the_platform_workspace() {
 // run's own bracket, and far fewer points classified at a fine step.
 
 fn compare(m: &Machine, opts: &WorkspaceOptions, factor: usize) -> (u64, u64) {
-    let uniform = workspace::compute(m, opts, &|_| {}, |_| Ok::<(), ()>(()))
+    let run = workspace::compute(m, opts, &|_| {}, |_| Ok::<(), ()>(()))
         .unwrap()
-        .unwrap()
-        .summary;
+        .unwrap();
+    let (uniform, uniform_map) = (run.summary, run.map);
     let adaptive = workspace::compute_adaptive(m, opts, factor, &|_| {}).unwrap();
     let name = format!(
         "{} {} mm, tool {} mm",
@@ -293,6 +293,32 @@ fn compare(m: &Machine, opts: &WorkspaceOptions, factor: usize) -> (u64, u64) {
         adaptive.volume_hi_mm3
     );
     assert_eq!(adaptive.binding[0], uniform.inside);
+    // The largest box: the one found is a box of the grid all inside, so no larger than the
+    // uniform grid's (exhaustive) largest box, and that is within the bound.
+    let (_, best) = uniform.largest_box_size().unwrap();
+    let found = adaptive.largest_box.unwrap();
+    let g = uniform.grid;
+    let grid_box =
+        |p: Vector3<f64>| [0, 1, 2].map(|d| ((p[d] - g.origin[d]) / g.step).round() as usize);
+    let (lo, hi) = (grid_box(found.min), grid_box(found.max));
+    for k in lo[2]..=hi[2] {
+        for j in lo[1]..=hi[1] {
+            for i in lo[0]..=hi[0] {
+                assert_eq!(
+                    uniform_map.at(i, j, k),
+                    Outcome::Inside,
+                    "{name}: the largest box {found:?} holds a point outside"
+                );
+            }
+        }
+    }
+    assert!(
+        adaptive.largest_box_mm3 <= best * (1.0 + 1e-12)
+            && best <= adaptive.largest_box_upper_mm3 * (1.0 + 1e-12),
+        "{name}: found {} <= uniform {best} <= bound {}",
+        adaptive.largest_box_mm3,
+        adaptive.largest_box_upper_mm3
+    );
     let (ub, ab) = (uniform.bbox.unwrap(), adaptive.bbox.unwrap());
     assert!(
         (ub.min - ab.min).norm() < 1e-9 && (ub.max - ab.max).norm() < 1e-9,

@@ -112,6 +112,14 @@ fn run_sweep(
             "ymax",
             "zmin",
             "zmax",
+            "largest_box_l",
+            "largest_box_upper_l",
+            "box_xmin",
+            "box_xmax",
+            "box_ymin",
+            "box_ymax",
+            "box_zmin",
+            "box_zmax",
             "points_classified",
             "seconds",
         ]
@@ -150,6 +158,17 @@ fn run_sweep(
                 row.extend(std::iter::repeat_n(String::new(), 6));
             }
         }
+        row.push(format!("{:.4}", a.largest_box_mm3 * 1e-6));
+        row.push(format!("{:.4}", a.largest_box_upper_mm3 * 1e-6));
+        match a.largest_box {
+            Some(b) => {
+                for d in 0..3 {
+                    row.push(b.min[d].to_string());
+                    row.push(b.max[d].to_string());
+                }
+            }
+            None => row.extend(std::iter::repeat_n(String::new(), 6)),
+        }
         row.push(a.classified.to_string());
         row.push(format!("{secs:.2}"));
         let outside = (a.lattice_points - a.inside_points).max(1) as f64;
@@ -164,6 +183,12 @@ fn run_sweep(
             volume_l: a.volume_mm3 * 1e-6,
             lo_l: a.volume_lo_mm3 * 1e-6,
             hi_l: a.volume_hi_mm3 * 1e-6,
+            box_l: if a.largest_box.is_some() {
+                a.largest_box_mm3 * 1e-6
+            } else {
+                f64::NAN
+            },
+            box_upper_l: a.largest_box_upper_mm3 * 1e-6,
         });
         sayln!(
             "verne workspace: {}: {:.3} l in {secs:.1} s",
@@ -269,6 +294,24 @@ fn run_adaptive(
                     ""
                 }
             );
+            match a.largest_box {
+                Some(b) => {
+                    let e = b.max - b.min;
+                    let _ = writeln!(
+                        text,
+                        "  largest box        {}: {} x {} x {} mm = {:.3} l (no box of the lattice is larger than {:.3} l)",
+                        range(&b),
+                        fmt_num(e.x, 3),
+                        fmt_num(e.y, 3),
+                        fmt_num(e.z, 3),
+                        a.largest_box_mm3 * 1e-6,
+                        a.largest_box_upper_mm3 * 1e-6
+                    );
+                }
+                None => {
+                    let _ = writeln!(text, "  largest box        (none with positive volume)");
+                }
+            }
         } else {
             any_empty = true;
             let _ = writeln!(text, "  no point inside");

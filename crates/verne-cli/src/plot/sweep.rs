@@ -1,6 +1,7 @@
-//! The picture of a design sweep (`verne workspace --sweep ... --plot`): the workspace volume
-//! against the first key, its bracket as a bar at each value, one line per value of the second
-//! key when there is one.
+//! The picture of a design sweep (`verne workspace --sweep ... --plot`): two panels against the
+//! first key, the workspace volume with its bracket as a bar at each value, and the largest box
+//! with its bound as a bar (the box found .. no box of the lattice is larger); one line per
+//! value of the second key when there is one.
 
 use std::path::Path;
 
@@ -9,12 +10,32 @@ use plotters::prelude::*;
 
 use super::{FAMILY, Format, draw_title_and_legend, drawing, io_err, register_font};
 
-/// One workspace of a sweep: its key values, the volume and its bracket (litres).
+/// One workspace of a sweep: its key values, the volume and its bracket, the largest box found
+/// and the volume no box exceeds (litres).
 pub struct SweepPoint {
     pub keys: Vec<f64>,
     pub volume_l: f64,
     pub lo_l: f64,
     pub hi_l: f64,
+    pub box_l: f64,
+    pub box_upper_l: f64,
+}
+
+impl SweepPoint {
+    /// The panel's value and its bar: the volume, or the largest box.
+    fn value(&self, panel: Panel) -> (f64, f64, f64) {
+        match panel {
+            Panel::Volume => (self.volume_l, self.lo_l, self.hi_l),
+            Panel::LargestBox => (self.box_l, self.box_l, self.box_upper_l),
+        }
+    }
+}
+
+/// The two panels of the picture.
+#[derive(Clone, Copy)]
+enum Panel {
+    Volume,
+    LargestBox,
 }
 
 /// Line colours, one per value of the second key (cycled).
@@ -27,7 +48,7 @@ const SERIES: [RGBColor; 6] = [
     RGBColor(140, 86, 75),
 ];
 
-const SIZE: (u32, u32) = (900, 620);
+const SIZE: (u32, u32) = (1200, 620);
 const LEGEND_HEIGHT_PX: u32 = 86;
 
 /// Draws the sweep: volume (l) against `keys[0]`, bracket bars, a line per `keys[1]` value.
@@ -37,31 +58,12 @@ pub fn sweep_picture(
     points: &[SweepPoint],
     title: &str,
 ) -> Result<(), String> {
-    let xs = points.iter().map(|p| p.keys[0]);
-    let (x0, x1) = xs
-        .clone()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
-            (a.min(x), b.max(x))
-        });
-    let ys = points
+    if !points
         .iter()
-        .flat_map(|p| [p.lo_l, p.hi_l])
-        .filter(|v| v.is_finite());
-    let (y0, y1) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), y| {
-        (a.min(y), b.max(y))
-    });
-    if !(x0.is_finite() && y0.is_finite()) {
+        .any(|p| p.volume_l.is_finite() && p.volume_l > 0.0)
+    {
         return Err("nothing to draw: no workspace of the sweep has a volume".into());
     }
-    let pad = |a: f64, b: f64| {
-        let d = if b > a {
-            0.05 * (b - a)
-        } else {
-            0.5 * a.abs().max(1.0)
-        };
-        (a - d, b + d)
-    };
-    let ((x0, x1), (y0, y1)) = (pad(x0, x1), pad(y0, y1));
     // The series: one per value of the second key, in order of appearance.
     let mut series: Vec<Option<f64>> = Vec::new();
     for p in points {
@@ -83,7 +85,8 @@ pub fn sweep_picture(
         .chain(std::iter::once((
             RGBColor(90, 90, 90),
             true,
-            "bar: the volume's bracket (cells all inside .. plus the boundary cells)".to_string(),
+            "bars: the volume's bracket; the largest box found .. no box of the lattice larger"
+                .to_string(),
         )))
         .collect();
     render!(
@@ -93,54 +96,95 @@ pub fn sweep_picture(
             root.fill(&WHITE).map_err(drawing)?;
             let (top, body) = root.split_vertically(LEGEND_HEIGHT_PX);
             draw_title_and_legend(&top, title, &entries)?;
-            let mut c = ChartBuilder::on(&body)
-                .margin(12)
-                .x_label_area_size(40)
-                .y_label_area_size(64)
-                .build_cartesian_2d(x0..x1, y0..y1)
-                .map_err(drawing)?;
-            c.configure_mesh()
-                .x_desc(keys[0])
-                .y_desc("workspace volume (l)")
-                .label_style((FAMILY, 12))
-                .axis_desc_style((FAMILY, 13))
-                .draw()
-                .map_err(drawing)?;
-            let cap = 0.006 * (x1 - x0);
-            for (k, s) in series.iter().enumerate() {
-                let colour = SERIES[k % SERIES.len()];
-                let mut line: Vec<&SweepPoint> = points
-                    .iter()
-                    .filter(|p| p.keys.get(1).copied() == *s)
-                    .collect();
-                line.sort_by(|a, b| a.keys[0].total_cmp(&b.keys[0]));
-                c.draw_series(LineSeries::new(
-                    line.iter().map(|p| (p.keys[0], p.volume_l)),
-                    colour.stroke_width(2),
-                ))
-                .map_err(drawing)?;
-                for p in &line {
-                    let x = p.keys[0];
-                    for seg in [
-                        vec![(x, p.lo_l), (x, p.hi_l)],
-                        vec![(x - cap, p.lo_l), (x + cap, p.lo_l)],
-                        vec![(x - cap, p.hi_l), (x + cap, p.hi_l)],
-                    ] {
-                        c.draw_series(std::iter::once(PathElement::new(
-                            seg,
-                            colour.stroke_width(1),
-                        )))
-                        .map_err(drawing)?;
-                    }
-                    c.draw_series(std::iter::once(Circle::new(
-                        (x, p.volume_l),
-                        4,
-                        colour.filled(),
-                    )))
-                    .map_err(drawing)?;
-                }
-            }
-            Ok(())
+            let (left, right) = body.split_horizontally(SIZE.0 / 2);
+            draw_panel(&left, keys[0], points, &series, Panel::Volume)?;
+            draw_panel(&right, keys[0], points, &series, Panel::LargestBox)
         }
     )
+}
+
+/// One panel: the panel's value against the first key, its bars, a line per series.
+fn draw_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    key: &str,
+    points: &[SweepPoint],
+    series: &[Option<f64>],
+    panel: Panel,
+) -> Result<(), String> {
+    let (x0, x1) = points
+        .iter()
+        .map(|p| p.keys[0])
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+            (a.min(x), b.max(x))
+        });
+    let (y0, y1) = points
+        .iter()
+        .flat_map(|p| {
+            let (_, lo, hi) = p.value(panel);
+            [lo, hi]
+        })
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), y| {
+            (a.min(y), b.max(y))
+        });
+    if !(x0.is_finite() && y0.is_finite()) {
+        return Ok(());
+    }
+    let pad = |a: f64, b: f64| {
+        let d = if b > a {
+            0.05 * (b - a)
+        } else {
+            0.5 * a.abs().max(1.0)
+        };
+        (a - d, b + d)
+    };
+    let ((x0, x1), (y0, y1)) = (pad(x0, x1), pad(y0, y1));
+    let mut c = ChartBuilder::on(area)
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(64)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(drawing)?;
+    c.configure_mesh()
+        .x_desc(key)
+        .y_desc(match panel {
+            Panel::Volume => "workspace volume (l)",
+            Panel::LargestBox => "largest box (l)",
+        })
+        .label_style((FAMILY, 12))
+        .axis_desc_style((FAMILY, 13))
+        .draw()
+        .map_err(drawing)?;
+    let cap = 0.006 * (x1 - x0);
+    for (k, s) in series.iter().enumerate() {
+        let colour = SERIES[k % SERIES.len()];
+        let mut line: Vec<&SweepPoint> = points
+            .iter()
+            .filter(|p| p.keys.get(1).copied() == *s && p.value(panel).0.is_finite())
+            .collect();
+        line.sort_by(|a, b| a.keys[0].total_cmp(&b.keys[0]));
+        c.draw_series(LineSeries::new(
+            line.iter().map(|p| (p.keys[0], p.value(panel).0)),
+            colour.stroke_width(2),
+        ))
+        .map_err(drawing)?;
+        for p in &line {
+            let x = p.keys[0];
+            let (v, lo, hi) = p.value(panel);
+            for seg in [
+                vec![(x, lo), (x, hi)],
+                vec![(x - cap, lo), (x + cap, lo)],
+                vec![(x - cap, hi), (x + cap, hi)],
+            ] {
+                c.draw_series(std::iter::once(PathElement::new(
+                    seg,
+                    colour.stroke_width(1),
+                )))
+                .map_err(drawing)?;
+            }
+            c.draw_series(std::iter::once(Circle::new((x, v), 4, colour.filled())))
+                .map_err(drawing)?;
+        }
+    }
+    Ok(())
 }

@@ -28,7 +28,9 @@
 use crate::par::*;
 use crate::spec::Machine;
 
+use super::GridBox;
 use super::grid::{Bounds, default_bounds, round_bounds};
+use super::refined_box::refined_largest_box;
 use super::{WorkspaceOptions, classify};
 
 /// The coarse step is the requested step times this, by default (a power of two).
@@ -73,6 +75,14 @@ pub struct AdaptiveSummary {
     pub binding: [u64; 7],
     /// The box of the inside points (mm), if any.
     pub bbox: Option<Bounds>,
+    /// The largest axis-aligned box of fine lattice points found inside (mm) and its volume
+    /// (mm^3): the coarse lattice's largest box grown face by face on the fine lattice
+    /// (`refined_box.rs`); and a volume no box of the fine lattice exceeds (mm^3).
+    pub largest_box: Option<Bounds>,
+    pub largest_box_mm3: f64,
+    pub largest_box_upper_mm3: f64,
+    /// Fine points classified to grow the largest box (not in `classified`).
+    pub box_points_classified: u64,
     /// An inside point on the lattice's outer layer: the bounds may cut the workspace.
     pub touches_bounds: bool,
 }
@@ -151,6 +161,10 @@ pub fn compute_adaptive(
         sampled_half_width_mm3: 0.0,
         binding: [0; 7],
         bbox: None,
+        largest_box: None,
+        largest_box_mm3: 0.0,
+        largest_box_upper_mm3: 0.0,
+        box_points_classified: 0,
         touches_bounds: false,
     };
     // A place in lattice units (a lattice point has whole coordinates).
@@ -160,7 +174,7 @@ pub fn compute_adaptive(
     };
     // Keys of 32 bits where the lattice allows (1 mm steps over the default machine's box do):
     // half the memory of the levels' lists.
-    let (tally, classified) = if summary.lattice_points <= u64::from(u32::MAX) {
+    let (tally, classified, coarse_inside) = if summary.lattice_points <= u64::from(u32::MAX) {
         refine::<u32>(&lattice, s0, &classify_point, progress)
     } else {
         refine::<u64>(&lattice, s0, &classify_point, progress)
@@ -193,19 +207,34 @@ pub fn compute_adaptive(
             max: point(hi),
         });
         summary.touches_bounds = (0..3).any(|d| lo[d] == 0 || hi[d] == n[d] - 1);
+        let coarse_n = n.map(|v| (v - 1) / s0 + 1);
+        let inside_at = |p: [usize; 3]| classify_point(p.map(|v| v as f64)) == INSIDE;
+        let bbox = GridBox { lo, hi };
+        let r = refined_largest_box(coarse_n, &coarse_inside, s0, bbox, &inside_at);
+        if let Some((g, v)) = r.found {
+            summary.largest_box = Some(Bounds {
+                min: point(g.lo),
+                max: point(g.hi),
+            });
+            summary.largest_box_mm3 = v * h3;
+        }
+        summary.largest_box_upper_mm3 = r.upper * h3;
+        summary.box_points_classified = r.classified;
     }
     Ok(summary)
 }
 
 /// The octree, level by level from the coarse cells (size `s0`) down to cells of one step:
-/// what the leaf cells add up to, and the points classified.
+/// what the leaf cells add up to, the points classified, and which points of the coarse
+/// lattice (every `s0`-th fine point, x fastest) are inside.
 fn refine<K: Key>(
     lattice: &Lattice,
     s0: usize,
     classify_point: &(dyn Fn([f64; 3]) -> u8 + Sync),
     progress: &(dyn Fn(u64) + Sync),
-) -> (Tally, u64) {
+) -> (Tally, u64, Vec<bool>) {
     let n = lattice.n;
+    let mut coarse_inside = Vec::new();
     let mut tally = Tally::empty();
     let mut classified = 0u64;
     // The cells of this level by their first corner's key, sorted; at first every coarse cell.
@@ -227,6 +256,16 @@ fn refine<K: Key>(
         classified += new_points;
         known = corners_here;
         progress(classified);
+        if s == s0 {
+            // Every coarse lattice point is a corner of the first level.
+            for k in (0..n[2]).step_by(s0) {
+                for j in (0..n[1]).step_by(s0) {
+                    for i in (0..n[0]).step_by(s0) {
+                        coarse_inside.push(known.at(lattice.key([i, j, k])) == INSIDE);
+                    }
+                }
+            }
+        }
         let (level, parents) = decide_level(lattice, &cells, s, &known);
         tally = tally.merge(&level);
         drop(cells);
@@ -268,7 +307,7 @@ fn refine<K: Key>(
             break;
         }
     }
-    (tally, classified)
+    (tally, classified, coarse_inside)
 }
 
 /// A lattice point's key: its index `i + n0 (j + n1 k)`, in 32 or 64 bits.
@@ -676,9 +715,10 @@ mod tests {
             let at = b.min + nalgebra::Vector3::from(p) * opts.step;
             classify(&m, &opts, &at).outcome.index() as u8
         };
-        let (t32, c32) = refine::<u32>(&lattice, 8, &classify_point, &|_| {});
-        let (t64, c64) = refine::<u64>(&lattice, 8, &classify_point, &|_| {});
+        let (t32, c32, m32) = refine::<u32>(&lattice, 8, &classify_point, &|_| {});
+        let (t64, c64, m64) = refine::<u64>(&lattice, 8, &classify_point, &|_| {});
         assert_eq!(c32, c64);
+        assert_eq!(m32, m64);
         assert!(t32.inside_points > 0);
         assert_eq!(
             (

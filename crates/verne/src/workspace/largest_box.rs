@@ -1,17 +1,66 @@
-//! The largest axis-aligned box of grid points all inside a workspace.
+//! The largest axis-aligned box of grid points all inside a workspace, for any measure of a
+//! box that grows with each of its edges (its volume; the volume of a box grown by a margin,
+//! which bounds the boxes of a finer lattice, see `adaptive.rs`).
 
 use super::{GridBox, Outcome, OutcomeGrid};
 
 /// Largest axis-aligned box of grid points all inside, by volume (edges counted in steps,
 /// corners on grid points), searched within the index box [lo, hi] of the inside points.
+/// `None` when no box has positive volume.
+pub fn largest_box(map: &OutcomeGrid, lo: [usize; 3], hi: [usize; 3]) -> Option<GridBox> {
+    let inside = |i: usize, j: usize, k: usize| map.at(i, j, k) == Outcome::Inside;
+    largest_box_by(&inside, lo, hi, BoxMeasure::Volume).map(|(b, _)| b)
+}
+
+/// What makes one box larger than another: a measure of its edges (in steps) that does not
+/// decrease when an edge grows.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum BoxMeasure {
+    /// The volume, in cubic steps.
+    Volume,
+    /// The volume of the box grown by `margin` steps along each edge: (a + m)(b + m)(c + m).
+    /// A box of one point or a plane of points counts (its grown volume is positive).
+    GrownVolume(f64),
+}
+
+impl BoxMeasure {
+    fn of(self, edges: [usize; 3]) -> f64 {
+        let [a, b, c] = edges.map(|e| e as f64);
+        match self {
+            BoxMeasure::Volume => a * b * c,
+            BoxMeasure::GrownVolume(m) => (a + m) * (b + m) * (c + m),
+        }
+    }
+
+    /// A bound on the measure of any box whose layer holds `count` points in a rectangle of
+    /// at most `nx` x `ny` points, with `dz` steps along z.
+    fn bound(self, count: u64, nx: usize, ny: usize, dz: usize) -> f64 {
+        let dz = dz as f64;
+        match self {
+            // (a)(b) edges <= (points along x - 1)(points along y - 1) < count.
+            BoxMeasure::Volume => count as f64 * dz,
+            // (a + m)(b + m) = ab + m (a + b) + m^2 with ab < count, a < nx, b < ny.
+            BoxMeasure::GrownVolume(m) => (count as f64 + m * (nx + ny) as f64 + m * m) * (dz + m),
+        }
+    }
+}
+
+/// The box of [`BoxMeasure`] largest among the boxes whose grid points are all inside (by
+/// `inside(i, j, k)`), searched within [lo, hi]; with its measure. `None` when no box has a
+/// positive measure.
 ///
 /// Exhaustive over every pair of z layers k0 <= k1: the AND of the layers' inside masks, then
-/// the largest rectangle of that 2D mask by the histogram-and-stack method (every maximal
-/// rectangle is visited, so any objective increasing in width and height is maximised; here
-/// (w - 1)(h - 1) points-to-edges). O(nz^2 nx ny) at worst, pruned: once the mask's count times
-/// the remaining height cannot beat the best box, the inner loop stops. Sequential, first best
-/// kept: deterministic. `None` when no box has positive volume.
-pub fn largest_box(map: &OutcomeGrid, lo: [usize; 3], hi: [usize; 3]) -> Option<GridBox> {
+/// the best rectangle of that 2D mask by the histogram-and-stack method (every maximal
+/// rectangle is visited, so any measure that does not decrease with width and height is
+/// maximised). O(nz^2 nx ny) at worst, pruned: once the measure's bound for the mask's count
+/// and the tallest box left cannot beat the best box, the inner loop stops. Sequential, first
+/// best kept: deterministic.
+pub fn largest_box_by(
+    inside: &dyn Fn(usize, usize, usize) -> bool,
+    lo: [usize; 3],
+    hi: [usize; 3],
+    measure: BoxMeasure,
+) -> Option<(GridBox, f64)> {
     if lo.iter().zip(&hi).any(|(l, h)| l > h) {
         return None;
     }
@@ -21,14 +70,14 @@ pub fn largest_box(map: &OutcomeGrid, lo: [usize; 3], hi: [usize; 3]) -> Option<
         let mut v = Vec::with_capacity(nx * ny);
         for j in lo[1]..=hi[1] {
             for i in lo[0]..=hi[0] {
-                v.push(map.at(i, j, k) == Outcome::Inside);
+                v.push(inside(i, j, k));
             }
         }
         v
     };
     let layers: Vec<Vec<bool>> = (lo[2]..=hi[2]).map(layer).collect();
     let nz = layers.len();
-    let mut best = 0u64;
+    let mut best = 0.0f64;
     let mut best_box = None;
     let mut heights = vec![0usize; nx];
     let mut stack: Vec<(usize, usize)> = Vec::with_capacity(nx + 1);
@@ -41,17 +90,17 @@ pub fn largest_box(map: &OutcomeGrid, lo: [usize; 3], hi: [usize; 3]) -> Option<
                 }
             }
             let count = mask.iter().filter(|&&b| b).count() as u64;
-            if count == 0 || count * (nz - 1 - k0) as u64 <= best {
+            if count == 0 || measure.bound(count, nx, ny, nz - 1 - k0) <= best {
                 break;
             }
-            let dz = (k1 - k0) as u64;
-            if dz == 0 || count * dz <= best {
+            let dz = k1 - k0;
+            if measure.bound(count, nx, ny, dz) <= best {
                 continue;
             }
-            // Largest (w - 1)(h - 1) rectangle of the mask.
+            // The best rectangle of the mask.
             heights.iter_mut().for_each(|h| *h = 0);
-            let mut best2 = 0u64;
-            let mut rect = [0usize; 4];
+            let mut best2 = best;
+            let mut rect = None;
             for j in 0..ny {
                 for (h, &m) in heights.iter_mut().zip(&mask[j * nx..(j + 1) * nx]) {
                     *h = if m { *h + 1 } else { 0 };
@@ -66,10 +115,10 @@ pub fn largest_box(map: &OutcomeGrid, lo: [usize; 3], hi: [usize; 3]) -> Option<
                         }
                         stack.pop();
                         if sh >= 1 {
-                            let val = ((i - s - 1) * (sh - 1)) as u64;
+                            let val = measure.of([i - s - 1, sh - 1, dz]);
                             if val > best2 {
                                 best2 = val;
-                                rect = [s, i - 1, j + 1 - sh, j];
+                                rect = Some([s, i - 1, j + 1 - sh, j]);
                             }
                         }
                         start = s;
@@ -77,15 +126,74 @@ pub fn largest_box(map: &OutcomeGrid, lo: [usize; 3], hi: [usize; 3]) -> Option<
                     stack.push((start, h));
                 }
             }
-            let vol = best2 * dz;
-            if vol > best {
-                best = vol;
+            if let Some(r) = rect {
+                best = best2;
                 best_box = Some(GridBox {
-                    lo: [lo[0] + rect[0], lo[1] + rect[2], lo[2] + k0],
-                    hi: [lo[0] + rect[1], lo[1] + rect[3], lo[2] + k1],
+                    lo: [lo[0] + r[0], lo[1] + r[2], lo[2] + k0],
+                    hi: [lo[0] + r[1], lo[1] + r[3], lo[2] + k1],
                 });
             }
         }
     }
-    best_box
+    best_box.map(|b| (b, best))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every box of a small random set against the search, by brute force over all corner
+    /// pairs, for both measures.
+    #[test]
+    fn the_search_finds_the_brute_force_best() {
+        let mut state = 12345u64;
+        for trial in 0..60 {
+            let n = [5 + trial % 3, 4 + trial % 4, 3 + trial % 5];
+            let cells: Vec<bool> = (0..n[0] * n[1] * n[2])
+                .map(|_| {
+                    state = state
+                        .wrapping_mul(6364136223846793005)
+                        .wrapping_add(1442695040888963407);
+                    (state >> 33) % 10 < 8
+                })
+                .collect();
+            let inside = |i: usize, j: usize, k: usize| cells[i + n[0] * (j + n[1] * k)];
+            let hi = n.map(|v| v - 1);
+            for measure in [BoxMeasure::Volume, BoxMeasure::GrownVolume(1.5)] {
+                let mut brute = 0.0f64;
+                for lo in itertools3(n) {
+                    for up in itertools3(n) {
+                        if (0..3).any(|d| up[d] < lo[d]) {
+                            continue;
+                        }
+                        let all = (lo[2]..=up[2]).all(|k| {
+                            (lo[1]..=up[1]).all(|j| (lo[0]..=up[0]).all(|i| inside(i, j, k)))
+                        });
+                        if all {
+                            brute = brute.max(measure.of([0, 1, 2].map(|d| up[d] - lo[d])));
+                        }
+                    }
+                }
+                let found = largest_box_by(&inside, [0; 3], hi, measure);
+                match found {
+                    None => assert_eq!(brute, 0.0, "trial {trial} {measure:?}"),
+                    Some((b, v)) => {
+                        assert_eq!(v, brute, "trial {trial} {measure:?}");
+                        assert_eq!(measure.of(b.edges()), v);
+                        for k in b.lo[2]..=b.hi[2] {
+                            for j in b.lo[1]..=b.hi[1] {
+                                for i in b.lo[0]..=b.hi[0] {
+                                    assert!(inside(i, j, k), "trial {trial}: {b:?}");
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    fn itertools3(n: [usize; 3]) -> impl Iterator<Item = [usize; 3]> {
+        (0..n[2]).flat_map(move |k| (0..n[1]).flat_map(move |j| (0..n[0]).map(move |i| [i, j, k])))
+    }
 }

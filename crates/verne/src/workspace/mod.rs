@@ -27,13 +27,15 @@
 //!
 //! The files: `grid.rs` (the box sampled and its grid, [`grid_for`]), `classify.rs` (one point:
 //! its branches and the binding constraint, [`classify()`]), `largest_box.rs` (the largest box
-//! inside, [`largest_box()`]); here, the types of a result and the run over the grid
-//! ([`compute`]).
+//! inside, [`largest_box()`]), `adaptive.rs` (the workspace at a fine step refined where the
+//! boundary passes, [`compute_adaptive`]), `refined_box.rs` (its largest box); here, the types
+//! of a result and the run over the grid ([`compute`]).
 
 mod adaptive;
 mod classify;
 mod grid;
 mod largest_box;
+mod refined_box;
 
 use nalgebra::Vector3;
 
@@ -47,7 +49,7 @@ pub use adaptive::{
 };
 pub use classify::{ALPHA_MATCH_RAD, classify, grid_point_of, manufacturing_tip, tool_tip};
 pub use grid::{Bounds, Grid, GridBox, MAX_GRID_POINTS, default_bounds, grid_for, round_bounds};
-pub use largest_box::largest_box;
+pub use largest_box::{BoxMeasure, largest_box, largest_box_by};
 
 /// Bounds on the velocity amplification factors (constraint (iii)): the comparative study's
 /// 1/3 < lambda_i < 3 (Wenger, Gosselin, Chablat 2001, eq. (4)).

@@ -1,0 +1,139 @@
+//! The largest box of an adaptive run (`adaptive.rs`), on the fine lattice without classifying
+//! it all: the largest box of the coarse lattice (every `s0`-th point), then grown face by face
+//! one fine step at a time while every fine point of the new face is inside (each face
+//! classified whole), until no face can move. The interior of the coarse box is taken from its
+//! coarse points, under the assumption the adaptive volume makes (a cell whose corners agree is
+//! all inside or all outside).
+//!
+//! And a bound: no box of the fine lattice is larger. A fine box B spans fine indices [p, q]
+//! along each axis; the coarse points in it form a box of the coarse lattice, all inside, whose
+//! edge is at least (q - p) - 2 (s0 - 1) fine steps. So B's volume is at most the largest volume
+//! of a coarse box grown by 2 (s0 - 1) fine steps along each edge ([`BoxMeasure::GrownVolume`],
+//! exhaustive on the coarse lattice), or, when B holds no coarse point along some axis (its
+//! extent there is at most s0 - 2 steps), a slab of that thickness across the inside points'
+//! bounding box.
+
+use crate::par::*;
+
+use super::GridBox;
+use super::largest_box::{BoxMeasure, largest_box_by};
+
+/// The largest box found and the bound, in fine lattice indices and fine steps^3.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct RefinedBox {
+    /// The box found (fine indices) and its volume (steps^3).
+    pub found: Option<(GridBox, f64)>,
+    /// No box of the fine lattice has a larger volume (steps^3).
+    pub upper: f64,
+    /// Fine points classified to grow the box.
+    pub classified: u64,
+}
+
+/// The coarse lattice: `n` points along each axis, `inside` x fastest; the fine lattice has
+/// `s0 (n - 1) + 1` points along each axis. `bbox` is the fine index box of the inside points.
+pub(crate) fn refined_largest_box(
+    coarse_n: [usize; 3],
+    coarse_inside: &[bool],
+    s0: usize,
+    bbox: GridBox,
+    inside_at: &(dyn Fn([usize; 3]) -> bool + Sync),
+) -> RefinedBox {
+    let at = |i: usize, j: usize, k: usize| coarse_inside[i + coarse_n[0] * (j + coarse_n[1] * k)];
+    let hi = coarse_n.map(|v| v - 1);
+    let s = s0 as f64;
+    // The bound first (it needs no fine point).
+    let margin = 2.0 * (s - 1.0) / s;
+    let grown_best = largest_box_by(&at, [0; 3], hi, BoxMeasure::GrownVolume(margin));
+    let grown = grown_best.map_or(0.0, |(_, v)| v * s * s * s);
+    let extent = bbox.edges().map(|e| e as f64);
+    let thin = (0..3)
+        .map(|d| (s - 2.0).max(0.0) * extent[(d + 1) % 3] * extent[(d + 2) % 3])
+        .fold(0.0f64, f64::max);
+    let mut result = RefinedBox {
+        found: None,
+        upper: grown.max(thin),
+        classified: 0,
+    };
+    // Two starts: the coarse lattice's largest box, and the coarse box that could grow the
+    // most (the bound's); the larger grown box is kept.
+    let mut starts: Vec<GridBox> = [
+        largest_box_by(&at, [0; 3], hi, BoxMeasure::Volume).map(|(b, _)| b),
+        grown_best.map(|(b, _)| b),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    starts.dedup();
+    let fine_n = coarse_n.map(|v| s0 * (v - 1) + 1);
+    for start in starts {
+        let fine = GridBox {
+            lo: start.lo.map(|v| v * s0),
+            hi: start.hi.map(|v| v * s0),
+        };
+        let (grown_box, classified) = grow(fine, fine_n, inside_at);
+        result.classified += classified;
+        let e = grown_box.edges().map(|v| v as f64);
+        let volume = e[0] * e[1] * e[2];
+        if result.found.is_none_or(|(_, v)| volume > v) {
+            result.found = Some((grown_box, volume));
+        }
+    }
+    result
+}
+
+/// Grows the box `b` of the fine lattice (`fine_n` points along each axis) one face and one
+/// step at a time while the new face's points are all inside, until no face moves; with the
+/// points classified. A face that cannot move never can again (the box only grows, so its next
+/// plane only widens), so it is not tried twice; each row of a plane stops at its first point outside.
+fn grow(
+    mut b: GridBox,
+    fine_n: [usize; 3],
+    inside_at: &(dyn Fn([usize; 3]) -> bool + Sync),
+) -> (GridBox, u64) {
+    let mut classified = 0u64;
+    let mut blocked = [false; 6];
+    while blocked.iter().any(|&x| !x) {
+        for (face, blocked) in blocked.iter_mut().enumerate() {
+            if *blocked {
+                continue;
+            }
+            let (d, up) = (face / 2, face % 2 == 1);
+            let plane = match up {
+                true if b.hi[d] + 1 < fine_n[d] => b.hi[d] + 1,
+                false if b.lo[d] > 0 => b.lo[d] - 1,
+                _ => {
+                    *blocked = true;
+                    continue;
+                }
+            };
+            let (e1, e2) = ((d + 1) % 3, (d + 2) % 3);
+            let cols = b.hi[e1] - b.lo[e1] + 1;
+            // Each row of the plane up to its first point outside (the same points whatever
+            // the threads): (points classified, rows with a point outside).
+            let (n, outside) = (b.lo[e2]..=b.hi[e2])
+                .into_par_iter()
+                .map(|row| {
+                    let mut p = [0usize; 3];
+                    p[d] = plane;
+                    p[e2] = row;
+                    for c in 0..cols {
+                        p[e1] = b.lo[e1] + c;
+                        if !inside_at(p) {
+                            return (c as u64 + 1, 1u64);
+                        }
+                    }
+                    (cols as u64, 0)
+                })
+                .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+            classified += n;
+            if outside > 0 {
+                *blocked = true;
+            } else if up {
+                b.hi[d] = plane;
+            } else {
+                b.lo[d] = plane;
+            }
+        }
+    }
+    (b, classified)
+}
