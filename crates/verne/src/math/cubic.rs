@@ -234,6 +234,99 @@ mod tests {
         assert_eq!(got[0].x, -1.0);
     }
 
+    /// Coefficients each off by at most err: the value of every cubic within those errors lies
+    /// within the bound of the computed value, and the bound is no wider than the errors' worst
+    /// case plus the rounding bound.
+    #[test]
+    fn the_error_bound_covers_the_coefficients_errors() {
+        let (c, err) = ([1.0, -2.0, 3.0, 0.5], [0.1, 0.05, 0.2, 0.01]);
+        for x in [-2.0, -0.5, 0.0, 0.7, 3.0] {
+            let (p, bound) = eval_with_error(&c, &err, x);
+            let rounding = eval_with_error(&c, &[0.0; 4], x).1;
+            let mut widest = 0.0f64;
+            for signs in 0..16u32 {
+                let shifted: [f64; 4] = std::array::from_fn(|i| {
+                    c[i] + if signs >> i & 1 == 1 { err[i] } else { -err[i] }
+                });
+                let q = eval_with_error(&shifted, &[0.0; 4], x).0;
+                assert!((q - p).abs() <= bound, "x={x}: |{q} - {p}| > {bound}");
+                widest = widest.max((q - p).abs());
+            }
+            assert!(
+                bound <= widest * (1.0 + 1e-9) + 2.0 * rounding,
+                "x={x}: {bound} vs {widest}"
+            );
+        }
+    }
+
+    /// Cubics of every scale (roots from 1e-3 to 1e3 apart, leading coefficients from 1e-4 to
+    /// 1e4, intervals cutting the roots anywhere): the same roots as the general routine, each
+    /// as exact as the cubic allows. Pieces next to a critical point, where p' vanishes at one
+    /// end, send Halley's step out of the bracket (then bisected).
+    #[test]
+    fn agrees_with_the_general_routine_at_every_scale() {
+        let mut unit = lcg(11);
+        let mut roots_seen = 0;
+        for _ in 0..20_000 {
+            let scale = 10f64.powf(6.0 * unit() - 3.0);
+            let centre = scale * (4.0 * unit() - 2.0);
+            let rs = [0; 3].map(|_| centre + scale * (2.0 * unit() - 1.0));
+            let lead = (if unit() < 0.5 { -1.0 } else { 1.0 }) * 10f64.powf(8.0 * unit() - 4.0);
+            let c = from_roots(rs, lead);
+            let (lo, hi) = (
+                centre - scale * (1.5 * unit()),
+                centre + scale * (1.5 * unit()),
+            );
+            let fast = cubic_roots_in(&c, lo, hi);
+            let slow = roots_in(&c, lo, hi);
+            assert_eq!(
+                fast.len(),
+                slow.len(),
+                "{rs:?} x {lead} on [{lo}, {hi}]: {fast:?} vs {slow:?}"
+            );
+            for (f, g) in fast.iter().zip(&slow) {
+                assert!(
+                    (f.x - g.x).abs() <= 1e-9 * scale.max(centre.abs()),
+                    "{rs:?} x {lead}: {fast:?} vs {slow:?}"
+                );
+                assert!(f.x >= lo && f.x <= hi, "{rs:?}: {f:?} outside [{lo}, {hi}]");
+                let (p, err) = eval_with_error(&c, &[0.0; 4], f.x);
+                assert!(p.abs() <= 2.0 * err, "{rs:?}: p({}) = {p:e} > {err:e}", f.x);
+            }
+            roots_seen += fast.len();
+        }
+        assert!(roots_seen > 20_000, "{roots_seen}");
+    }
+
+    /// The deflation decides alike at every scale of the coefficients (its margins are
+    /// relative to them), and refuses a root within its margin of either end of the interval.
+    #[test]
+    fn deflation_is_scale_free_and_refuses_roots_at_the_ends() {
+        let mut unit = lcg(13);
+        for _ in 0..5_000 {
+            let w = 0.5 + 0.5 * unit();
+            let (r2, r3) = (2.4 * unit() - 1.2, 2.4 * unit() - 1.2);
+            let c = from_roots([w, r2, r3], 0.3 + unit());
+            let base = deflated_roots_in(&c, w, -1.0, 0.45);
+            for f in [1e-4, 1e4] {
+                let scaled = c.map(|v| v * f);
+                let got = deflated_roots_in(&scaled, w, -1.0, 0.45);
+                assert_eq!(got.is_some(), base.is_some(), "{w} {r2} {r3} x {f}");
+                if let (Some(a), Some(b)) = (&got, &base) {
+                    assert_eq!(a.len(), b.len());
+                    for (x, y) in a.iter().zip(b) {
+                        assert!((x - y).abs() < 1e-9);
+                    }
+                }
+            }
+        }
+        // A root just inside either end: a close call, left to the isolator.
+        for (lo, hi, r) in [(-1.0, 0.45, -1.0 + 1e-11), (-1.0, 0.45, 0.45 - 1e-11)] {
+            let c = from_roots([0.8, r, -0.2], 1.0);
+            assert_eq!(deflated_roots_in(&c, 0.8, lo, hi), None, "root {r}");
+        }
+    }
+
     /// The deflated roots are the isolator's, to rounding, whenever they decide.
     #[test]
     fn deflation_agrees_with_isolation() {
