@@ -48,8 +48,8 @@ fn counts<'py>(
 /// cost of the boundary, and from one pseudo-random point in each of about 200,000 boundary
 /// cells `volume_sampled_mm3` +- `sampled_half_width_mm3` (99.7 % confidence). Uniform sampling gives every point: `points=True` adds
 /// `grid_points[N, 3]` (mm) and `outcome[N]` (int8, index into `verne.OUTCOMES`, x fastest).
-/// Returns a dict: the volume, its error, the bounding box, the largest box (adaptive: the box
-/// found on the fine lattice with `upper_bound_mm3`, a volume no box of it exceeds), the points
+/// Returns a dict: the volume, its error, the bounding box, the largest box and cube (adaptive:
+/// found on the fine lattice, with `upper_bound_mm3`, a volume none of it exceeds), the points
 /// per outcome and per failed constraint.
 ///
 /// >>> w = verne.workspace(m, step=40)
@@ -156,6 +156,17 @@ fn workspace<'py>(
             }
             None => d.set_item("largest_box", py.None())?,
         }
+        match a.largest_cube {
+            Some(b) => {
+                let lc = PyDict::new(py);
+                lc.set_item("min", <[f64; 3]>::from(b.min))?;
+                lc.set_item("max", <[f64; 3]>::from(b.max))?;
+                lc.set_item("volume_mm3", a.largest_cube_mm3)?;
+                lc.set_item("upper_bound_mm3", a.largest_cube_upper_mm3)?;
+                d.set_item("largest_cube", lc)?;
+            }
+            None => d.set_item("largest_cube", py.None())?,
+        }
         d.set_item("touches_bounds", a.touches_bounds)?;
         d.set_item(
             "binding",
@@ -196,6 +207,16 @@ fn workspace<'py>(
             d.set_item("largest_box", lb)?;
         }
         None => d.set_item("largest_box", py.None())?,
+    }
+    match w.largest_cube_size() {
+        Some((b, volume)) => {
+            let lc = PyDict::new(py);
+            lc.set_item("min", <[f64; 3]>::from(b.min))?;
+            lc.set_item("max", <[f64; 3]>::from(b.max))?;
+            lc.set_item("volume_mm3", volume)?;
+            d.set_item("largest_cube", lc)?;
+        }
+        None => d.set_item("largest_cube", py.None())?,
     }
     d.set_item("touches_bounds", w.touches_bounds)?;
     d.set_item(

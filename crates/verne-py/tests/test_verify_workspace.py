@@ -95,6 +95,10 @@ def test_workspace_is_verne_workspace():
     # The largest box: no larger than the uniform grid's exhaustive one, which is within the bound.
     best = u["largest_box"]["volume_mm3"]
     assert a["largest_box"]["volume_mm3"] <= best <= a["largest_box"]["upper_bound_mm3"]
+    cube = u["largest_cube"]["volume_mm3"]
+    assert a["largest_cube"]["volume_mm3"] <= cube <= a["largest_cube"]["upper_bound_mm3"]
+    edges = [hi - lo for lo, hi in zip(u["largest_cube"]["min"], u["largest_cube"]["max"])]
+    assert max(edges) - min(edges) < 1e-9 and cube == pytest.approx(edges[0] ** 3)
     assert math.isclose(
         a["largest_box"]["volume_mm3"] * 1e-6, summary_number(text, r"mm = ([\d.]+) l \(no box"), abs_tol=1e-3
     )

@@ -21,7 +21,7 @@ fn main() {
     }
     let m = Machine::default_verne();
     println!(
-        "step_mm,classified,lattice_points,seconds,volume_l,bracket_lo_l,bracket_hi_l,error_bound_pct,sampled_l,sampled_half_width_pct,sampled_cells,largest_box_l,largest_box_upper_l,box_points,uniform_inside,adaptive_inside,uniform_seconds"
+        "step_mm,classified,lattice_points,seconds,volume_l,bracket_lo_l,bracket_hi_l,error_bound_pct,sampled_l,sampled_half_width_pct,sampled_cells,largest_box_l,largest_box_upper_l,largest_cube_l,largest_cube_upper_l,box_points,uniform_inside,adaptive_inside,uniform_seconds"
     );
     for step in steps {
         let opts = WorkspaceOptions {
@@ -40,15 +40,19 @@ fn main() {
                 .unwrap()
                 .unwrap();
             let best = u.summary.largest_box_size().map_or(0.0, |b| b.1 * 1e-6);
+            let cube = u.summary.largest_cube_size().map_or(0.0, |b| b.1 * 1e-6);
             (
-                format!("{} (largest box {best:.4} l)", u.summary.inside),
+                format!(
+                    "{} (largest box {best:.4} l; cube {cube:.4} l)",
+                    u.summary.inside
+                ),
                 format!("{:.2}", t.elapsed().as_secs_f64()),
             )
         } else {
             (String::new(), String::new())
         };
         println!(
-            "{step},{},{},{secs:.2},{:.4},{:.4},{:.4},{:.3},{:.4},{:.4},{},{:.4},{:.4},{},{ui},{},{us}",
+            "{step},{},{},{secs:.2},{:.4},{:.4},{:.4},{:.3},{:.4},{:.4},{},{:.4},{:.4},{:.4},{:.4},{},{ui},{},{us}",
             a.classified,
             a.lattice_points,
             a.volume_mm3 * 1e-6,
@@ -60,7 +64,9 @@ fn main() {
             a.sampled_cells,
             a.largest_box_mm3 * 1e-6,
             a.largest_box_upper_mm3 * 1e-6,
-            a.box_points_classified,
+            a.largest_cube_mm3 * 1e-6,
+            a.largest_cube_upper_mm3 * 1e-6,
+            a.box_points_examined,
             a.inside_points
         );
     }

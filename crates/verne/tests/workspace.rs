@@ -312,6 +312,32 @@ fn compare(m: &Machine, opts: &WorkspaceOptions, factor: usize) -> (u64, u64) {
             }
         }
     }
+    // The same for the largest cube.
+    let (_, best_cube) = uniform.largest_cube_size().unwrap();
+    let cube = adaptive.largest_cube.unwrap();
+    let (lo, hi) = (grid_box(cube.min), grid_box(cube.max));
+    assert!(
+        hi[0] - lo[0] == hi[1] - lo[1] && hi[1] - lo[1] == hi[2] - lo[2],
+        "{name}: a cube"
+    );
+    for k in lo[2]..=hi[2] {
+        for j in lo[1]..=hi[1] {
+            for i in lo[0]..=hi[0] {
+                assert_eq!(
+                    uniform_map.at(i, j, k),
+                    Outcome::Inside,
+                    "{name}: cube {cube:?}"
+                );
+            }
+        }
+    }
+    assert!(
+        adaptive.largest_cube_mm3 <= best_cube * (1.0 + 1e-12)
+            && best_cube <= adaptive.largest_cube_upper_mm3 * (1.0 + 1e-12),
+        "{name}: cube found {} <= uniform {best_cube} <= bound {}",
+        adaptive.largest_cube_mm3,
+        adaptive.largest_cube_upper_mm3
+    );
     assert!(
         adaptive.largest_box_mm3 <= best * (1.0 + 1e-12)
             && best <= adaptive.largest_box_upper_mm3 * (1.0 + 1e-12),

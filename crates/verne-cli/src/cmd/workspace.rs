@@ -120,6 +120,8 @@ fn run_sweep(
             "box_ymax",
             "box_zmin",
             "box_zmax",
+            "largest_cube_l",
+            "largest_cube_upper_l",
             "points_classified",
             "seconds",
         ]
@@ -169,6 +171,8 @@ fn run_sweep(
             }
             None => row.extend(std::iter::repeat_n(String::new(), 6)),
         }
+        row.push(format!("{:.4}", a.largest_cube_mm3 * 1e-6));
+        row.push(format!("{:.4}", a.largest_cube_upper_mm3 * 1e-6));
         row.push(a.classified.to_string());
         row.push(format!("{secs:.2}"));
         let outside = (a.lattice_points - a.inside_points).max(1) as f64;
@@ -310,6 +314,21 @@ fn run_adaptive(
                 }
                 None => {
                     let _ = writeln!(text, "  largest box        (none with positive volume)");
+                }
+            }
+            match a.largest_cube {
+                Some(b) => {
+                    let _ = writeln!(
+                        text,
+                        "  largest cube       {}: edge {} mm = {:.3} l (no cube of the lattice is larger than {:.3} l)",
+                        range(&b),
+                        fmt_num(b.max.x - b.min.x, 3),
+                        a.largest_cube_mm3 * 1e-6,
+                        a.largest_cube_upper_mm3 * 1e-6
+                    );
+                }
+                None => {
+                    let _ = writeln!(text, "  largest cube       (none with positive volume)");
                 }
             }
         } else {
@@ -660,6 +679,20 @@ fn describe(out: &mut String, s: &WorkspaceSummary, elapsed: Duration) {
         }
         None => {
             let _ = writeln!(out, "  largest box        (none with positive volume)");
+        }
+    }
+    match s.largest_cube_size() {
+        Some((b, v)) => {
+            let _ = writeln!(
+                out,
+                "  largest cube       {}: edge {} mm = {:.3} l",
+                range(&b),
+                fmt_num(b.max.x - b.min.x, 3),
+                v * 1e-6
+            );
+        }
+        None => {
+            let _ = writeln!(out, "  largest cube       (none with positive volume)");
         }
     }
     if s.touches_bounds {

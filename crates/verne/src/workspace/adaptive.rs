@@ -81,8 +81,13 @@ pub struct AdaptiveSummary {
     pub largest_box: Option<Bounds>,
     pub largest_box_mm3: f64,
     pub largest_box_upper_mm3: f64,
-    /// Fine points classified to grow the largest box (not in `classified`).
-    pub box_points_classified: u64,
+    /// The largest cube found the same way (mm), its volume and its bound (mm^3).
+    pub largest_cube: Option<Bounds>,
+    pub largest_cube_mm3: f64,
+    pub largest_cube_upper_mm3: f64,
+    /// Fine points examined to grow the largest box and cube (in a leaf cell all inside, or
+    /// classified; not in `classified`).
+    pub box_points_examined: u64,
     /// An inside point on the lattice's outer layer: the bounds may cut the workspace.
     pub touches_bounds: bool,
 }
@@ -164,7 +169,10 @@ pub fn compute_adaptive(
         largest_box: None,
         largest_box_mm3: 0.0,
         largest_box_upper_mm3: 0.0,
-        box_points_classified: 0,
+        largest_cube: None,
+        largest_cube_mm3: 0.0,
+        largest_cube_upper_mm3: 0.0,
+        box_points_examined: 0,
         touches_bounds: false,
     };
     // A place in lattice units (a lattice point has whole coordinates).
@@ -174,11 +182,12 @@ pub fn compute_adaptive(
     };
     // Keys of 32 bits where the lattice allows (1 mm steps over the default machine's box do):
     // half the memory of the levels' lists.
-    let (tally, classified, coarse_inside) = if summary.lattice_points <= u64::from(u32::MAX) {
+    let refined = if summary.lattice_points <= u64::from(u32::MAX) {
         refine::<u32>(&lattice, s0, &classify_point, progress)
     } else {
         refine::<u64>(&lattice, s0, &classify_point, progress)
     };
+    let (tally, classified) = (refined.tally, refined.classified);
     summary.classified = classified;
     summary.inside_points = tally.inside_points;
     summary.boundary_cells = tally.boundary_cells;
@@ -208,9 +217,16 @@ pub fn compute_adaptive(
         });
         summary.touches_bounds = (0..3).any(|d| lo[d] == 0 || hi[d] == n[d] - 1);
         let coarse_n = n.map(|v| (v - 1) / s0 + 1);
-        let inside_at = |p: [usize; 3]| classify_point(p.map(|v| v as f64)) == INSIDE;
+        // A point in a leaf cell all inside is inside (the volume's assumption); others are
+        // classified.
+        let inside_at = |p: [usize; 3]| {
+            refined.inside_leaves.iter().any(|(size, keys)| {
+                let cell = p.map(|v| v / size * size);
+                keys.binary_search(&lattice.key::<u64>(cell)).is_ok()
+            }) || classify_point(p.map(|v| v as f64)) == INSIDE
+        };
         let bbox = GridBox { lo, hi };
-        let r = refined_largest_box(coarse_n, &coarse_inside, s0, bbox, &inside_at);
+        let r = refined_largest_box(coarse_n, &refined.coarse_inside, s0, bbox, &inside_at);
         if let Some((g, v)) = r.found {
             summary.largest_box = Some(Bounds {
                 min: point(g.lo),
@@ -219,22 +235,29 @@ pub fn compute_adaptive(
             summary.largest_box_mm3 = v * h3;
         }
         summary.largest_box_upper_mm3 = r.upper * h3;
-        summary.box_points_classified = r.classified;
+        if let Some((g, v)) = r.cube {
+            summary.largest_cube = Some(Bounds {
+                min: point(g.lo),
+                max: point(g.hi),
+            });
+            summary.largest_cube_mm3 = v * h3;
+        }
+        summary.largest_cube_upper_mm3 = r.cube_upper * h3;
+        summary.box_points_examined = r.classified;
     }
     Ok(summary)
 }
 
-/// The octree, level by level from the coarse cells (size `s0`) down to cells of one step:
-/// what the leaf cells add up to, the points classified, and which points of the coarse
-/// lattice (every `s0`-th fine point, x fastest) are inside.
+/// The octree, level by level from the coarse cells (size `s0`) down to cells of one step.
 fn refine<K: Key>(
     lattice: &Lattice,
     s0: usize,
     classify_point: &(dyn Fn([f64; 3]) -> u8 + Sync),
     progress: &(dyn Fn(u64) + Sync),
-) -> (Tally, u64, Vec<bool>) {
+) -> Refined {
     let n = lattice.n;
     let mut coarse_inside = Vec::new();
+    let mut inside_leaves = Vec::new();
     let mut tally = Tally::empty();
     let mut classified = 0u64;
     // The cells of this level by their first corner's key, sorted; at first every coarse cell.
@@ -268,6 +291,16 @@ fn refine<K: Key>(
         }
         let (level, parents) = decide_level(lattice, &cells, s, &known);
         tally = tally.merge(&level);
+        if s >= s0 / 2 && s >= 2 {
+            // The leaf cells all inside of the two coarsest levels (most of the interior), for
+            // the largest box: a point in one is inside without being classified.
+            let leaves: Vec<u64> = cells
+                .par_iter()
+                .filter(|&&c| parents.binary_search(&c).is_err() && known.at(c) == INSIDE)
+                .map(|&c| c.index() as u64)
+                .collect();
+            inside_leaves.push((s, leaves));
+        }
         drop(cells);
         if s == 2 {
             // The last level, cells of one step, slab by slab: it is most of the points. A cell
@@ -307,7 +340,25 @@ fn refine<K: Key>(
             break;
         }
     }
-    (tally, classified, coarse_inside)
+    Refined {
+        tally,
+        classified,
+        coarse_inside,
+        inside_leaves,
+    }
+}
+
+/// What [`refine`] found.
+struct Refined {
+    /// What the leaf cells add up to.
+    tally: Tally,
+    /// Points classified.
+    classified: u64,
+    /// Which points of the coarse lattice (every `s0`-th fine point, x fastest) are inside.
+    coarse_inside: Vec<bool>,
+    /// For the two coarsest levels, the cell size and the sorted keys (64-bit) of the leaf
+    /// cells whose corners are all inside.
+    inside_leaves: Vec<(usize, Vec<u64>)>,
 }
 
 /// A lattice point's key: its index `i + n0 (j + n1 k)`, in 32 or 64 bits.
@@ -715,10 +766,12 @@ mod tests {
             let at = b.min + nalgebra::Vector3::from(p) * opts.step;
             classify(&m, &opts, &at).outcome.index() as u8
         };
-        let (t32, c32, m32) = refine::<u32>(&lattice, 8, &classify_point, &|_| {});
-        let (t64, c64, m64) = refine::<u64>(&lattice, 8, &classify_point, &|_| {});
+        let r32 = refine::<u32>(&lattice, 8, &classify_point, &|_| {});
+        let r64 = refine::<u64>(&lattice, 8, &classify_point, &|_| {});
+        let (t32, c32, t64, c64) = (r32.tally, r32.classified, r64.tally, r64.classified);
         assert_eq!(c32, c64);
-        assert_eq!(m32, m64);
+        assert_eq!(r32.coarse_inside, r64.coarse_inside);
+        assert_eq!(r32.inside_leaves, r64.inside_leaves);
         assert!(t32.inside_points > 0);
         assert_eq!(
             (

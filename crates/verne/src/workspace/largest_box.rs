@@ -1,6 +1,6 @@
 //! The largest axis-aligned box of grid points all inside a workspace, for any measure of a
-//! box that grows with each of its edges (its volume; the volume of a box grown by a margin,
-//! which bounds the boxes of a finer lattice, see `adaptive.rs`).
+//! box that does not decrease when an edge grows (its volume, the largest cube it holds; the
+//! same grown by a margin, which bound the boxes of a finer lattice, see `refined_box.rs`).
 
 use super::{GridBox, Outcome, OutcomeGrid};
 
@@ -12,6 +12,22 @@ pub fn largest_box(map: &OutcomeGrid, lo: [usize; 3], hi: [usize; 3]) -> Option<
     largest_box_by(&inside, lo, hi, BoxMeasure::Volume).map(|(b, _)| b)
 }
 
+/// Largest axis-aligned cube of grid points all inside (edge counted in steps, corners on grid
+/// points), searched within [lo, hi]. `None` when no cube has a positive edge.
+pub fn largest_cube(map: &OutcomeGrid, lo: [usize; 3], hi: [usize; 3]) -> Option<GridBox> {
+    let inside = |i: usize, j: usize, k: usize| map.at(i, j, k) == Outcome::Inside;
+    largest_box_by(&inside, lo, hi, BoxMeasure::Cube).map(|(b, _)| cube_in(&b))
+}
+
+/// The cube of a box's shortest edge at the box's first corner.
+pub fn cube_in(b: &GridBox) -> GridBox {
+    let e = b.edges().into_iter().min().unwrap_or(0);
+    GridBox {
+        lo: b.lo,
+        hi: b.lo.map(|v| v + e),
+    }
+}
+
 /// What makes one box larger than another: a measure of its edges (in steps) that does not
 /// decrease when an edge grows.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -21,6 +37,10 @@ pub enum BoxMeasure {
     /// The volume of the box grown by `margin` steps along each edge: (a + m)(b + m)(c + m).
     /// A box of one point or a plane of points counts (its grown volume is positive).
     GrownVolume(f64),
+    /// The volume of the largest cube inside the box: its shortest edge, cubed.
+    Cube,
+    /// The volume of that cube grown by `margin` steps along each edge.
+    GrownCube(f64),
 }
 
 impl BoxMeasure {
@@ -29,6 +49,8 @@ impl BoxMeasure {
         match self {
             BoxMeasure::Volume => a * b * c,
             BoxMeasure::GrownVolume(m) => (a + m) * (b + m) * (c + m),
+            BoxMeasure::Cube => a.min(b).min(c).powi(3),
+            BoxMeasure::GrownCube(m) => (a.min(b).min(c) + m).powi(3),
         }
     }
 
@@ -41,6 +63,9 @@ impl BoxMeasure {
             BoxMeasure::Volume => count as f64 * dz,
             // (a + m)(b + m) = ab + m (a + b) + m^2 with ab < count, a < nx, b < ny.
             BoxMeasure::GrownVolume(m) => (count as f64 + m * (nx + ny) as f64 + m * m) * (dz + m),
+            // min(a, b)^2 <= ab < count.
+            BoxMeasure::Cube => (count as f64).sqrt().min(dz).powi(3),
+            BoxMeasure::GrownCube(m) => ((count as f64).sqrt().min(dz) + m).powi(3),
         }
     }
 }
@@ -159,7 +184,12 @@ mod tests {
                 .collect();
             let inside = |i: usize, j: usize, k: usize| cells[i + n[0] * (j + n[1] * k)];
             let hi = n.map(|v| v - 1);
-            for measure in [BoxMeasure::Volume, BoxMeasure::GrownVolume(1.5)] {
+            for measure in [
+                BoxMeasure::Volume,
+                BoxMeasure::GrownVolume(1.5),
+                BoxMeasure::Cube,
+                BoxMeasure::GrownCube(0.75),
+            ] {
                 let mut brute = 0.0f64;
                 for lo in itertools3(n) {
                     for up in itertools3(n) {

@@ -49,7 +49,7 @@ pub use adaptive::{
 };
 pub use classify::{ALPHA_MATCH_RAD, classify, grid_point_of, manufacturing_tip, tool_tip};
 pub use grid::{Bounds, Grid, GridBox, MAX_GRID_POINTS, default_bounds, grid_for, round_bounds};
-pub use largest_box::{BoxMeasure, largest_box, largest_box_by};
+pub use largest_box::{BoxMeasure, cube_in, largest_box, largest_box_by, largest_cube};
 
 /// Bounds on the velocity amplification factors (constraint (iii)): the comparative study's
 /// 1/3 < lambda_i < 3 (Wenger, Gosselin, Chablat 2001, eq. (4)).
@@ -279,6 +279,8 @@ pub struct WorkspaceSummary {
     pub bbox: Option<Bounds>,
     /// Largest axis-aligned box whose grid points are all inside (corners are grid points).
     pub largest_box: Option<GridBox>,
+    /// Largest axis-aligned cube whose grid points are all inside.
+    pub largest_cube: Option<GridBox>,
     /// True when an inside point lies on the outer faces of the grid: the bounds cut the
     /// workspace and the volume is a lower bound.
     pub touches_bounds: bool,
@@ -302,7 +304,16 @@ impl WorkspaceSummary {
 
     /// Size (mm) and volume (mm^3) of the largest inside box.
     pub fn largest_box_size(&self) -> Option<(Bounds, f64)> {
-        self.largest_box.map(|b| {
+        self.box_size(self.largest_box)
+    }
+
+    /// Size (mm) and volume (mm^3) of the largest inside cube.
+    pub fn largest_cube_size(&self) -> Option<(Bounds, f64)> {
+        self.box_size(self.largest_cube)
+    }
+
+    fn box_size(&self, b: Option<GridBox>) -> Option<(Bounds, f64)> {
+        b.map(|b| {
             let g = &self.grid;
             let lo = g.point(b.lo[0], b.lo[1], b.lo[2]);
             let hi = g.point(b.hi[0], b.hi[1], b.hi[2]);
@@ -382,6 +393,7 @@ pub fn compute<E>(
         max: grid.point(hi[0], hi[1], hi[2]),
     });
     let largest_box = (inside > 0).then(|| largest_box(&map, lo, hi)).flatten();
+    let largest_cube = (inside > 0).then(|| largest_cube(&map, lo, hi)).flatten();
     let summary = WorkspaceSummary {
         of: opts.of,
         tool_length: opts.tool_length,
@@ -393,6 +405,7 @@ pub fn compute<E>(
         volume_double_step_mm3: inside_even as f64 * 8.0 * h3,
         bbox,
         largest_box,
+        largest_cube,
         touches_bounds: touches,
         binding,
         failures,

@@ -1,9 +1,12 @@
 //! The largest box of an adaptive run (`adaptive.rs`), on the fine lattice without classifying
 //! it all: the largest box of the coarse lattice (every `s0`-th point), then grown face by face
-//! one fine step at a time while every fine point of the new face is inside (each face
-//! classified whole), until no face can move. The interior of the coarse box is taken from its
-//! coarse points, under the assumption the adaptive volume makes (a cell whose corners agree is
-//! all inside or all outside).
+//! one fine step at a time while every fine point of the new face is inside, until no face can
+//! move; grown also from the box that bounds the rest and from the cubes below, the largest
+//! result kept. A point of a new face is inside when it lies in a leaf cell of the octree's two
+//! coarsest levels whose corners are all inside (most of a face, away from the boundary), and
+//! is classified otherwise; the interior of the coarse box is taken from its coarse points:
+//! both under the assumption the adaptive volume makes (a cell whose corners agree is all
+//! inside or all outside).
 //!
 //! And a bound: no box of the fine lattice is larger. A fine box B spans fine indices [p, q]
 //! along each axis; the coarse points in it form a box of the coarse lattice, all inside, whose
@@ -12,11 +15,16 @@
 //! exhaustive on the coarse lattice), or, when B holds no coarse point along some axis (its
 //! extent there is at most s0 - 2 steps), a slab of that thickness across the inside points'
 //! bounding box.
+//!
+//! The largest cube likewise: the coarse lattice's (at the first corner and at the middle of
+//! the coarse box of the longest shortest edge, and of the one that bounds the rest), grown one
+//! fine step along each axis at a time (the face of each axis that is not blocked), with the
+//! bound of the coarse cubes grown by the same margin ([`BoxMeasure::GrownCube`]).
 
 use crate::par::*;
 
 use super::GridBox;
-use super::largest_box::{BoxMeasure, largest_box_by};
+use super::largest_box::{BoxMeasure, cube_in, largest_box_by};
 
 /// The largest box found and the bound, in fine lattice indices and fine steps^3.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -25,7 +33,10 @@ pub(crate) struct RefinedBox {
     pub found: Option<(GridBox, f64)>,
     /// No box of the fine lattice has a larger volume (steps^3).
     pub upper: f64,
-    /// Fine points classified to grow the box.
+    /// The largest cube found (fine indices) and its volume, and the bound (steps^3).
+    pub cube: Option<(GridBox, f64)>,
+    pub cube_upper: f64,
+    /// Fine points examined to grow the box and the cube.
     pub classified: u64,
 }
 
@@ -49,28 +60,65 @@ pub(crate) fn refined_largest_box(
     let thin = (0..3)
         .map(|d| (s - 2.0).max(0.0) * extent[(d + 1) % 3] * extent[(d + 2) % 3])
         .fold(0.0f64, f64::max);
+    let grown_cube_best = largest_box_by(&at, [0; 3], hi, BoxMeasure::GrownCube(margin));
+    let grown_cube = grown_cube_best.map_or(0.0, |(_, v)| v * s * s * s);
     let mut result = RefinedBox {
         found: None,
         upper: grown.max(thin),
+        cube: None,
+        cube_upper: grown_cube.max((s - 2.0).max(0.0).powi(3)),
         classified: 0,
     };
-    // Two starts: the coarse lattice's largest box, and the coarse box that could grow the
-    // most (the bound's); the larger grown box is kept.
-    let mut starts: Vec<GridBox> = [
-        largest_box_by(&at, [0; 3], hi, BoxMeasure::Volume).map(|(b, _)| b),
-        grown_best.map(|(b, _)| b),
+    let fine_n = coarse_n.map(|v| s0 * (v - 1) + 1);
+    let to_fine = |b: GridBox| GridBox {
+        lo: b.lo.map(|v| v * s0),
+        hi: b.hi.map(|v| v * s0),
+    };
+    // The cube: grown from the cubes at the first corner and at the middle of the coarse box
+    // of the longest shortest edge and of the one that bounds the rest; the largest kept.
+    let mut cube_starts: Vec<GridBox> = [
+        largest_box_by(&at, [0; 3], hi, BoxMeasure::Cube),
+        grown_cube_best,
     ]
     .into_iter()
     .flatten()
-    .collect();
-    starts.dedup();
-    let fine_n = coarse_n.map(|v| s0 * (v - 1) + 1);
-    for start in starts {
-        let fine = GridBox {
-            lo: start.lo.map(|v| v * s0),
-            hi: start.hi.map(|v| v * s0),
+    .flat_map(|(b, _)| {
+        let c = cube_in(&b);
+        let e = c.edges()[0];
+        let middle = GridBox {
+            lo: [0, 1, 2].map(|d| b.lo[d] + (b.hi[d] - b.lo[d] - e) / 2),
+            hi: [0, 1, 2].map(|d| b.lo[d] + (b.hi[d] - b.lo[d] - e) / 2 + e),
         };
-        let (grown_box, classified) = grow(fine, fine_n, inside_at);
+        [c, middle]
+    })
+    .map(to_fine)
+    .collect();
+    cube_starts.sort_by_key(|c| (c.lo, c.hi));
+    cube_starts.dedup();
+    let mut cubes = Vec::new();
+    for start in cube_starts {
+        let (cube, classified) = grow_cube(start, fine_n, inside_at);
+        result.classified += classified;
+        cubes.push(cube);
+        let v = (cube.edges()[0] as f64).powi(3);
+        if result.cube.is_none_or(|(_, best)| v > best) {
+            result.cube = Some((cube, v));
+        }
+    }
+    // The box: grown from the coarse lattice's largest box, the coarse box that could grow
+    // the most (the bound's) and the cubes grown (a cube is a box); the largest kept.
+    let mut starts: Vec<GridBox> = [
+        largest_box_by(&at, [0; 3], hi, BoxMeasure::Volume).map(|(b, _)| to_fine(b)),
+        grown_best.map(|(b, _)| to_fine(b)),
+    ]
+    .into_iter()
+    .flatten()
+    .chain(cubes)
+    .collect();
+    starts.sort_by_key(|c| (c.lo, c.hi));
+    starts.dedup();
+    for start in starts {
+        let (grown_box, classified) = grow(start, fine_n, inside_at);
         result.classified += classified;
         let e = grown_box.edges().map(|v| v as f64);
         let volume = e[0] * e[1] * e[2];
@@ -84,7 +132,7 @@ pub(crate) fn refined_largest_box(
 /// Grows the box `b` of the fine lattice (`fine_n` points along each axis) one face and one
 /// step at a time while the new face's points are all inside, until no face moves; with the
 /// points classified. A face that cannot move never can again (the box only grows, so its next
-/// plane only widens), so it is not tried twice; each row of a plane stops at its first point outside.
+/// plane only widens), so it is not tried twice.
 fn grow(
     mut b: GridBox,
     fine_n: [usize; 3],
@@ -94,46 +142,83 @@ fn grow(
     let mut blocked = [false; 6];
     while blocked.iter().any(|&x| !x) {
         for (face, blocked) in blocked.iter_mut().enumerate() {
-            if *blocked {
-                continue;
-            }
-            let (d, up) = (face / 2, face % 2 == 1);
-            let plane = match up {
-                true if b.hi[d] + 1 < fine_n[d] => b.hi[d] + 1,
-                false if b.lo[d] > 0 => b.lo[d] - 1,
-                _ => {
-                    *blocked = true;
-                    continue;
-                }
-            };
-            let (e1, e2) = ((d + 1) % 3, (d + 2) % 3);
-            let cols = b.hi[e1] - b.lo[e1] + 1;
-            // Each row of the plane up to its first point outside (the same points whatever
-            // the threads): (points classified, rows with a point outside).
-            let (n, outside) = (b.lo[e2]..=b.hi[e2])
-                .into_par_iter()
-                .map(|row| {
-                    let mut p = [0usize; 3];
-                    p[d] = plane;
-                    p[e2] = row;
-                    for c in 0..cols {
-                        p[e1] = b.lo[e1] + c;
-                        if !inside_at(p) {
-                            return (c as u64 + 1, 1u64);
-                        }
-                    }
-                    (cols as u64, 0)
-                })
-                .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
-            classified += n;
-            if outside > 0 {
+            if !*blocked && !try_face(&mut b, face, fine_n, inside_at, &mut classified) {
                 *blocked = true;
-            } else if up {
-                b.hi[d] = plane;
-            } else {
-                b.lo[d] = plane;
             }
         }
     }
     (b, classified)
+}
+
+/// Grows the cube `b` one fine step along each axis at a time (by the face of each axis not
+/// yet blocked, the upper one first), until an axis has both faces blocked.
+fn grow_cube(
+    mut b: GridBox,
+    fine_n: [usize; 3],
+    inside_at: &(dyn Fn([usize; 3]) -> bool + Sync),
+) -> (GridBox, u64) {
+    let mut classified = 0u64;
+    let mut blocked = [false; 6];
+    loop {
+        let before = b;
+        for d in 0..3 {
+            let grown = [2 * d + 1, 2 * d].into_iter().any(|face| {
+                let ok =
+                    !blocked[face] && try_face(&mut b, face, fine_n, inside_at, &mut classified);
+                if !ok {
+                    blocked[face] = true;
+                }
+                ok
+            });
+            if !grown {
+                return (before, classified);
+            }
+        }
+    }
+}
+
+/// Moves `face` (2 d for the lower face along axis d, 2 d + 1 for the upper) of `b` one step out
+/// if the lattice goes on and every point of the new plane within `b` is inside; whether it
+/// moved. Each row of the plane is classified up to its first point outside (the same points
+/// whatever the threads), counted in `classified`.
+fn try_face(
+    b: &mut GridBox,
+    face: usize,
+    fine_n: [usize; 3],
+    inside_at: &(dyn Fn([usize; 3]) -> bool + Sync),
+    classified: &mut u64,
+) -> bool {
+    let (d, up) = (face / 2, face % 2 == 1);
+    let plane = match up {
+        true if b.hi[d] + 1 < fine_n[d] => b.hi[d] + 1,
+        false if b.lo[d] > 0 => b.lo[d] - 1,
+        _ => return false,
+    };
+    let (e1, e2) = ((d + 1) % 3, (d + 2) % 3);
+    let (lo1, cols) = (b.lo[e1], b.hi[e1] - b.lo[e1] + 1);
+    let (n, outside) = (b.lo[e2]..=b.hi[e2])
+        .into_par_iter()
+        .map(|row| {
+            let mut p = [0usize; 3];
+            p[d] = plane;
+            p[e2] = row;
+            for c in 0..cols {
+                p[e1] = lo1 + c;
+                if !inside_at(p) {
+                    return (c as u64 + 1, 1u64);
+                }
+            }
+            (cols as u64, 0)
+        })
+        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+    *classified += n;
+    if outside > 0 {
+        return false;
+    }
+    if up {
+        b.hi[d] = plane;
+    } else {
+        b.lo[d] = plane;
+    }
+    true
 }
