@@ -694,3 +694,26 @@ fn candidates_refilled_in_place_are_the_fresh_ones() {
         }
     }
 }
+
+/// Joints or a tool length that are not finite give no assembly mode (not a mode with a NaN
+/// tool pose), whichever of them it is.
+#[test]
+fn non_finite_joints_give_no_mode() {
+    let m = Machine::default_verne();
+    let rho = Vector3::new(520.690065682, 228.944160917, 228.769607739);
+    assert!(!machine_fk(&m, &rho, FRAC_PI_6, 0.0, DELTA).is_empty());
+    for bad in [f64::NAN, f64::INFINITY] {
+        assert!(
+            machine_fk(&m, &rho, bad, 0.0, DELTA).is_empty(),
+            "theta1 {bad}"
+        );
+        assert!(
+            machine_fk(&m, &rho, FRAC_PI_6, bad, DELTA).is_empty(),
+            "theta2 {bad}"
+        );
+        assert!(
+            machine_fk(&m, &rho, FRAC_PI_6, 0.0, bad).is_empty(),
+            "tool length {bad}"
+        );
+    }
+}
