@@ -24,8 +24,8 @@ use super::{
     Item, JointSource, Joints, PairingError, PathPoint, RowSource, Summary, VerifyOptions,
     Violation, machine_kind, verify,
 };
-use crate::machine::machine_fk;
 use crate::machine::orientation::{move_angles, tool_axis};
+use crate::machine::{MachineFkModes, machine_fk};
 use crate::parallel_module::ik::wrap_angle;
 use crate::spec::Machine;
 
@@ -303,6 +303,8 @@ struct Projected<'a, E> {
     last: LastRow,
     index: u64,
     previous: Option<PathPoint>,
+    /// The assembly modes of the joint row just projected, for the row check.
+    modes: Option<Box<MachineFkModes>>,
     _error: std::marker::PhantomData<E>,
 }
 
@@ -318,14 +320,21 @@ impl<E> RowSource for Projected<'_, E> {
         false
     }
 
+    fn take_joint_modes(&mut self) -> Option<Box<MachineFkModes>> {
+        self.modes.take()
+    }
+
     fn next_item(&mut self) -> Result<Option<Item<PathPoint>>, E> {
+        self.modes = None;
         let Some(row) = self.last.lock().unwrap_or_else(|e| e.into_inner()).take() else {
             return Ok(None);
         };
         self.index += 1;
         let nearest = row.ok().and_then(|q| {
-            // The tool pose of the machine's assembly mode (the row check picks the same kind).
+            // The tool pose of the machine's assembly mode (the row check picks the same kind,
+            // from these modes: they go with the row).
             let modes = machine_fk(self.machine, &q.rho, q.theta1, q.theta2, self.tool_length);
+            let modes = &**self.modes.insert(Box::new(modes));
             let mode = modes
                 .iter()
                 .filter(|md| machine_kind(md.config, md.module.alpha, self.machine))
@@ -380,6 +389,7 @@ where
         last,
         index: 0,
         previous: None,
+        modes: None,
         _error: std::marker::PhantomData,
     };
     verify(m, opt, &mut tee, &mut projected, report)

@@ -34,7 +34,7 @@ use nalgebra::Vector3;
 
 use crate::error::shown;
 use crate::machine::orientation::ROTARY_SINGULAR_CONE_RAD;
-use crate::machine::{machine_fk, tool_pose_eq26};
+use crate::machine::{MachineFkModes, machine_fk, tool_pose_eq26};
 use crate::par::*;
 use crate::parallel_module::branches::{Config, Reason, WORKING_CONFIG, config_of};
 use crate::parallel_module::equations::{ModulePose, Sliders, polish_pose, residual_mm, rod_tilts};
@@ -212,6 +212,12 @@ pub trait RowSource {
     fn has_id(&self) -> bool;
     /// The next row, or `None` at the end.
     fn next_item(&mut self) -> Result<Option<Item<Self::Row>>, Self::Error>;
+    /// The assembly modes of the joint row just paired with the row just read, when this
+    /// source computed them to find that row (a recording's nearest path point), so that the
+    /// row check does not compute them again. The default: none.
+    fn take_joint_modes(&mut self) -> Option<Box<MachineFkModes>> {
+        None
+    }
 }
 
 /// The joint table: rows of [`Joints`], and whether they carry a time (`t` or `feed`).
@@ -355,6 +361,8 @@ impl VerifyBatch {
 struct Paired {
     joints: Item<Joints>,
     point: Option<Item<PathPoint>>,
+    /// The joint row's assembly modes, when the pairing computed them.
+    modes: Option<Box<MachineFkModes>>,
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -663,6 +671,7 @@ where
                 (Some(j), Some(p)) => Ok(Some(Paired {
                     joints: j,
                     point: Some(p),
+                    modes: path.take_joint_modes(),
                 })),
                 (Some(j), None) => Err(PairingError::ExtraJointRow {
                     joints: joints.name().to_string(),
@@ -703,6 +712,7 @@ where
                 return Ok(Some(Paired {
                     joints: j,
                     point: Some(p),
+                    modes: None,
                 }));
             }
             while !*path_done {
@@ -714,6 +724,7 @@ where
                             return Ok(Some(Paired {
                                 joints: j,
                                 point: Some(p),
+                                modes: None,
                             }));
                         }
                         if let Some(old) = pending.get(&pid) {
@@ -732,6 +743,7 @@ where
             Ok(Some(Paired {
                 joints: j,
                 point: None,
+                modes: None,
             }))
         }
     }

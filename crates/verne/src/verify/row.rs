@@ -59,7 +59,15 @@ pub(super) fn eval_row(
         },
     };
     e.point = Some(point);
-    let modes = machine_fk(m, &q.rho, q.theta1, q.theta2, opt.tool_length);
+    // The modes the pairing computed (a recording's), or computed here.
+    let computed;
+    let modes = match &p.modes {
+        Some(modes) => &**modes,
+        None => {
+            computed = machine_fk(m, &q.rho, q.theta1, q.theta2, opt.tool_length);
+            &computed
+        }
+    };
     let chosen = modes
         .iter()
         .filter(|md| machine_kind(md.config, md.module.alpha, m))
