@@ -327,6 +327,58 @@ mod tests {
         }
     }
 
+    /// The bisection fallback of `bracketed`, taken when a Halley step leaves the bracket or
+    /// the secant point rounds onto an end: cubics found by a search (three close roots, a
+    /// piece ending at a critical point) where a wrong midpoint, or a step accepted outside
+    /// the bracket, ends outside the bracket or off the root.
+    #[test]
+    fn bracketed_stays_in_its_bracket_when_halley_leaves_it() {
+        let p = |c: &[f64; 4], x: f64| ((c[3] * x + c[2]) * x + c[1]) * x + c[0];
+        let cases: [([f64; 4], f64, f64); 3] = [
+            (
+                [
+                    -0.04345861414348768,
+                    0.21993079631705534,
+                    -0.37100090178523837,
+                    0.208613605235847,
+                ],
+                -3.0,
+                0.5927837808208003,
+            ),
+            (
+                [
+                    -0.026385612361595225,
+                    0.04639586726295099,
+                    -0.027193816183017125,
+                    0.0053129993017665906,
+                ],
+                1.7059467563456108,
+                1.7062898653776517,
+            ),
+            (
+                [
+                    0.004116549612865756,
+                    -0.04392864687966058,
+                    0.15625756180030367,
+                    -0.18527337211025333,
+                ],
+                0.28113141265356956,
+                3.0,
+            ),
+        ];
+        for (c, a, b) in cases {
+            let (fa, fb) = (p(&c, a), p(&c, b));
+            assert!(
+                (fa < 0.0) != (fb < 0.0),
+                "{c:?}: a sign change on [{a}, {b}]"
+            );
+            let r = bracketed(&c, a, b, fa, fb);
+            assert!(r.x >= a && r.x <= b, "{c:?}: {} outside [{a}, {b}]", r.x);
+            let (v, err) = eval_with_error(&c, &[0.0; 4], r.x);
+            assert!(v.abs() <= 2.0 * err, "{c:?}: p({}) = {v:e} > {err:e}", r.x);
+        }
+    }
+
     /// The deflated roots are the isolator's, to rounding, whenever they decide.
     #[test]
     fn deflation_agrees_with_isolation() {
