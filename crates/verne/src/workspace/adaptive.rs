@@ -243,7 +243,7 @@ pub fn compute_adaptive(
             summary.largest_cube_mm3 = v * h3;
         }
         summary.largest_cube_upper_mm3 = r.cube_upper * h3;
-        summary.box_points_examined = r.classified;
+        summary.box_points_examined = r.examined;
     }
     Ok(summary)
 }

@@ -37,7 +37,7 @@ pub(crate) struct RefinedBox {
     pub cube: Option<(GridBox, f64)>,
     pub cube_upper: f64,
     /// Fine points examined to grow the box and the cube.
-    pub classified: u64,
+    pub examined: u64,
 }
 
 /// The coarse lattice: `n` points along each axis, `inside` x fastest; the fine lattice has
@@ -67,7 +67,7 @@ pub(crate) fn refined_largest_box(
         upper: grown.max(thin),
         cube: None,
         cube_upper: grown_cube.max((s - 2.0).max(0.0).powi(3)),
-        classified: 0,
+        examined: 0,
     };
     let fine_n = coarse_n.map(|v| s0 * (v - 1) + 1);
     let to_fine = |b: GridBox| GridBox {
@@ -97,8 +97,8 @@ pub(crate) fn refined_largest_box(
     cube_starts.dedup();
     let mut cubes = Vec::new();
     for start in cube_starts {
-        let (cube, classified) = grow_cube(start, fine_n, inside_at);
-        result.classified += classified;
+        let (cube, examined) = grow_cube(start, fine_n, inside_at);
+        result.examined += examined;
         cubes.push(cube);
         let v = (cube.edges()[0] as f64).powi(3);
         if result.cube.is_none_or(|(_, best)| v > best) {
@@ -118,8 +118,8 @@ pub(crate) fn refined_largest_box(
     starts.sort_by_key(|c| (c.lo, c.hi));
     starts.dedup();
     for start in starts {
-        let (grown_box, classified) = grow(start, fine_n, inside_at);
-        result.classified += classified;
+        let (grown_box, examined) = grow(start, fine_n, inside_at);
+        result.examined += examined;
         let e = grown_box.edges().map(|v| v as f64);
         let volume = e[0] * e[1] * e[2];
         if result.found.is_none_or(|(_, v)| volume > v) {
@@ -131,23 +131,23 @@ pub(crate) fn refined_largest_box(
 
 /// Grows the box `b` of the fine lattice (`fine_n` points along each axis) one face and one
 /// step at a time while the new face's points are all inside, until no face moves; with the
-/// points classified. A face that cannot move never can again (the box only grows, so its next
+/// points examined. A face that cannot move never can again (the box only grows, so its next
 /// plane only widens), so it is not tried twice.
 fn grow(
     mut b: GridBox,
     fine_n: [usize; 3],
     inside_at: &(dyn Fn([usize; 3]) -> bool + Sync),
 ) -> (GridBox, u64) {
-    let mut classified = 0u64;
+    let mut examined = 0u64;
     let mut blocked = [false; 6];
     while blocked.iter().any(|&x| !x) {
         for (face, blocked) in blocked.iter_mut().enumerate() {
-            if !*blocked && !try_face(&mut b, face, fine_n, inside_at, &mut classified) {
+            if !*blocked && !try_face(&mut b, face, fine_n, inside_at, &mut examined) {
                 *blocked = true;
             }
         }
     }
-    (b, classified)
+    (b, examined)
 }
 
 /// Grows the cube `b` one fine step along each axis at a time (by the face of each axis not
@@ -157,21 +157,20 @@ fn grow_cube(
     fine_n: [usize; 3],
     inside_at: &(dyn Fn([usize; 3]) -> bool + Sync),
 ) -> (GridBox, u64) {
-    let mut classified = 0u64;
+    let mut examined = 0u64;
     let mut blocked = [false; 6];
     loop {
         let before = b;
         for d in 0..3 {
             let grown = [2 * d + 1, 2 * d].into_iter().any(|face| {
-                let ok =
-                    !blocked[face] && try_face(&mut b, face, fine_n, inside_at, &mut classified);
+                let ok = !blocked[face] && try_face(&mut b, face, fine_n, inside_at, &mut examined);
                 if !ok {
                     blocked[face] = true;
                 }
                 ok
             });
             if !grown {
-                return (before, classified);
+                return (before, examined);
             }
         }
     }
@@ -179,14 +178,14 @@ fn grow_cube(
 
 /// Moves `face` (2 d for the lower face along axis d, 2 d + 1 for the upper) of `b` one step out
 /// if the lattice goes on and every point of the new plane within `b` is inside; whether it
-/// moved. Each row of the plane is classified up to its first point outside (the same points
-/// whatever the threads), counted in `classified`.
+/// moved. Each row of the plane is examined up to its first point outside (the same points
+/// whatever the threads), counted in `examined`.
 fn try_face(
     b: &mut GridBox,
     face: usize,
     fine_n: [usize; 3],
     inside_at: &(dyn Fn([usize; 3]) -> bool + Sync),
-    classified: &mut u64,
+    examined: &mut u64,
 ) -> bool {
     let (d, up) = (face / 2, face % 2 == 1);
     let plane = match up {
@@ -211,7 +210,7 @@ fn try_face(
             (cols as u64, 0)
         })
         .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
-    *classified += n;
+    *examined += n;
     if outside > 0 {
         return false;
     }
