@@ -254,6 +254,33 @@ mod tests {
         assert!((r[0].x - 0.5).abs() < 1e-15);
     }
 
+    /// Coefficient errors on every coefficient of a degree-8 polynomial (the largest degree):
+    /// the derivative's errors (i err[i]) fit, and the roots are those of the exact routine.
+    /// At a small scale a derivative error far too wide (err[i] + i, say) would make the
+    /// derivative look zero everywhere and lose the two roots between its critical points.
+    #[test]
+    fn small_coefficient_errors_keep_every_root() {
+        // 1e-3 (x + 0.9)(x + 0.2)(x - 0.3)(x - 0.6)(x - 2)(x - 3)(x + 4)(x - 5): roots in [-1, 1].
+        let mut c = vec![1e-3];
+        for r in [-0.9, -0.2, 0.3, 0.6, 2.0, 3.0, -4.0, 5.0] {
+            let mut next = vec![0.0; c.len() + 1];
+            for (i, a) in c.iter().enumerate() {
+                next[i + 1] += a;
+                next[i] -= a * r;
+            }
+            c = next;
+        }
+        assert_eq!(c.len(), MAX_DEGREE + 1);
+        let err = [1e-15; MAX_DEGREE + 1];
+        let exact = roots_in(&c, -1.0, 1.0);
+        let with_error = roots_in_with_error(&c, &err, -1.0, 1.0);
+        assert_eq!(exact.len(), 4, "{exact:?}");
+        assert_eq!(with_error.len(), exact.len(), "{with_error:?}");
+        for (a, b) in exact.iter().zip(&with_error) {
+            assert!((a.x - b.x).abs() < 1e-9, "{exact:?} vs {with_error:?}");
+        }
+    }
+
     #[test]
     fn the_error_bound_covers_the_coefficients_errors() {
         // Coefficients each off by at most err: the value of every polynomial within those
