@@ -411,3 +411,32 @@ pub fn working(modes: &[FkMode]) -> Option<&FkMode> {
         .filter(|b| b.working())
         .min_by(|a, b| a.pose.alpha.abs().total_cmp(&b.pose.alpha.abs()))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The points on the four spheres at a fixed alpha (the cross-check where condition (21)
+    /// fails) hold the pose the sliders were computed from: P, its working branch's alpha and
+    /// sliders, back to P (a pose constructed to be true).
+    #[test]
+    fn fixed_alpha_points_hold_the_pose_of_the_sliders() {
+        let m = Machine::default_verne();
+        for p in [
+            Vector3::new(-300.0, 0.0, 1100.0),
+            Vector3::new(-250.0, 120.0, 1050.0),
+            Vector3::new(-370.0, -60.0, 1100.0),
+        ] {
+            let branches = crate::parallel_module::ik::solve(&m, &p);
+            let b = crate::parallel_module::ik::working(&branches).expect("a working branch");
+            let sc = b.alpha.sin_cos();
+            let points = fixed_alpha_points(&m.module, &b.rho, b.alpha, sc);
+            assert!(
+                points
+                    .iter()
+                    .any(|q| (q.p - p).norm() < 1e-6 && q.alpha == b.alpha),
+                "{p:?}: {points:?}"
+            );
+        }
+    }
+}
