@@ -42,7 +42,7 @@ macro_rules! sayln_verbose {
 /// default), 2 also the machine, timings and rates (`-v`).
 static VERBOSITY: std::sync::atomic::AtomicU8 = std::sync::atomic::AtomicU8::new(1);
 
-/// The verbosity set by `-q`/`-v` ([`VERBOSITY`]).
+/// The verbosity set by `-q`/`-v` (`VERBOSITY`).
 pub fn verbosity() -> u8 {
     VERBOSITY.load(std::sync::atomic::Ordering::Relaxed)
 }

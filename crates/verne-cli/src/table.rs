@@ -140,7 +140,7 @@ impl CsvSource {
         &self.name
     }
 
-    /// Takes each row's line in messages from the column `name` (see [`CsvSource::line_of`]).
+    /// Takes each row's line in messages from the column `name` (see [`line_of`]).
     pub fn with_line_column(mut self, name: &str) -> CsvSource {
         self.line_column = self.column(name);
         self
@@ -562,7 +562,7 @@ pub fn read_input_file(path: &Path) -> io::Result<Vec<u8>> {
 /// (the same file under any name: a hard or symbolic link too) is refused, since the run would
 /// replace what it reads; so is an existing file without any write permission (root could
 /// otherwise replace it).
-/// [`check_output_target`], and the directory the file goes to exists: checked before a
+/// `check_output_target`, and the directory the file goes to exists: checked before a
 /// command computes anything, so a bad output path fails at once.
 pub fn check_output_path(path: &Path) -> io::Result<()> {
     let dir = match path.parent() {

@@ -169,7 +169,7 @@ fn open_cl_file(path: &Path, name: &str, options: Options) -> Result<PathInput, 
 
 /// Prints what the reader saw besides the rows to stderr, prefixed `verne CMD: NAME:`: every
 /// warning, the rows, dialect and units, the records skipped (names only, one line, shortened
-/// past [`SKIPPED_SHOWN`] kinds) and the tool changes. Nothing is dropped silently: a warning
+/// past `SKIPPED_SHOWN` kinds) and the tool changes. Nothing is dropped silently: a warning
 /// or tool change the reader stopped keeping is counted.
 /// `tool_length` is the length the joints were computed with: a tool length the file gives
 /// (NX `TLDATA`) that differs from it is a warning, since it is not applied.
