@@ -439,4 +439,24 @@ mod tests {
             );
         }
     }
+
+    /// Where the three planes share a line (legs II and III alike, rho2 = rho3, alpha = 0: the
+    /// plane where condition (21) fails), the points are where that line meets leg I's sphere:
+    /// two, the pose among them, both on all four spheres.
+    #[test]
+    fn fixed_alpha_points_on_a_line_of_candidates() {
+        let text = crate::spec::DEFAULT_MACHINE_TOML.replace("L3 = 950.46", "L3 = 950.30");
+        let m = Machine::from_toml_str(&text, "symmetric").unwrap();
+        let p = Vector3::new(-300.0, 0.0, 1100.0);
+        let branches = crate::parallel_module::ik::solve(&m, &p);
+        let b = crate::parallel_module::ik::working(&branches).expect("a working branch");
+        assert_eq!(b.alpha, 0.0);
+        assert_eq!(b.rho.y, b.rho.z);
+        let points = fixed_alpha_points(&m.module, &b.rho, 0.0, (0.0, 1.0));
+        assert_eq!(points.len(), 2, "{points:?}");
+        assert!(points.iter().any(|q| (q.p - p).norm() < 1e-6), "{points:?}");
+        for q in &points {
+            assert!(residual_mm(&m.module, q, &b.rho) < 1e-6, "{q:?}");
+        }
+    }
 }
