@@ -440,6 +440,33 @@ mod tests {
         }
     }
 
+    /// The zeros of Det = A cos + B sin + C on the circle: each on the unit circle and a zero,
+    /// two where the line crosses it, one where it touches, none where it misses it or Det is
+    /// constant.
+    #[test]
+    fn det_zeros_are_on_the_circle_and_zeros() {
+        use crate::math::trig::Trig;
+        for (c0, a, b, n) in [
+            (0.3, 1.0, 0.5, 2),
+            (-0.7, -0.2, 1.3, 2),
+            (0.0, 2.0, 0.0, 2),
+            (1.0, 0.0, 1.0, 1),
+            (-1.0, 1.0, 0.0, 1),
+            (2.0, 1.0, 1.0, 0),
+            (1.0, 0.0, 0.0, 0),
+        ] {
+            let z = det_zeros(&Trig::linear(c0, a, b));
+            assert_eq!(z.len(), n, "{c0} + {a} cos + {b} sin: {z:?}");
+            for &(s, c) in &z {
+                assert!((s * s + c * c - 1.0).abs() < 1e-12, "{z:?}");
+                assert!((a * c + b * s + c0).abs() < 1e-12, "{z:?}");
+            }
+            if n == 2 {
+                assert!((z[0].0 - z[1].0).abs() + (z[0].1 - z[1].1).abs() > 1e-6);
+            }
+        }
+    }
+
     /// Where the three planes share a line (legs II and III alike, rho2 = rho3, alpha = 0: the
     /// plane where condition (21) fails), the points are where that line meets leg I's sphere:
     /// two, the pose among them, both on all four spheres.
