@@ -440,6 +440,29 @@ mod tests {
         }
     }
 
+    /// On the plane where condition (21) fails (legs II and III alike, rho2 = rho3), the mode
+    /// at alpha = 0 is found by the proof and again by the fixed-alpha points: reported once.
+    #[test]
+    fn a_mode_found_twice_is_reported_once() {
+        let text = crate::spec::DEFAULT_MACHINE_TOML.replace("L3 = 950.46", "L3 = 950.30");
+        let m = Machine::from_toml_str(&text, "symmetric").unwrap();
+        let p = Vector3::new(-300.0, 0.0, 1100.0);
+        let branches = crate::parallel_module::ik::solve(&m, &p);
+        let b = crate::parallel_module::ik::working(&branches).expect("a working branch");
+        let modes = solve(&m, &b.rho);
+        assert!(
+            modes.iter().any(|md| (md.pose.p - p).norm() < 1e-6),
+            "{modes:?}"
+        );
+        for (i, x) in modes.iter().enumerate() {
+            for y in &modes[i + 1..] {
+                let apart =
+                    (x.pose.p - y.pose.p).norm() + wrap_angle(x.pose.alpha - y.pose.alpha).abs();
+                assert!(apart > 1e-6, "a mode twice: {x:?} {y:?}");
+            }
+        }
+    }
+
     /// The zeros of Det = A cos + B sin + C on the circle: each on the unit circle and a zero,
     /// two where the line crosses it, one where it touches, none where it misses it or Det is
     /// constant.
