@@ -464,8 +464,8 @@ mod tests {
     }
 
     /// The zeros of Det = A cos + B sin + C on the circle: each on the unit circle and a zero,
-    /// two where the line crosses it, one where it touches, none where it misses it or Det is
-    /// constant.
+    /// two where the line crosses it, one where it touches, none where it misses it, where Det
+    /// is constant (zero included) or not finite.
     #[test]
     fn det_zeros_are_on_the_circle_and_zeros() {
         use crate::math::trig::Trig;
@@ -477,6 +477,8 @@ mod tests {
             (-1.0, 1.0, 0.0, 1),
             (2.0, 1.0, 1.0, 0),
             (1.0, 0.0, 0.0, 0),
+            (0.0, 0.0, 0.0, 0),
+            (0.0, f64::INFINITY, 1.0, 0),
         ] {
             let z = det_zeros(&Trig::linear(c0, a, b));
             assert_eq!(z.len(), n, "{c0} + {a} cos + {b} sin: {z:?}");
