@@ -71,8 +71,8 @@ pub struct AdaptiveSummary {
     pub volume_sampled_mm3: f64,
     pub sampled_half_width_mm3: f64,
     /// Lattice points by outcome ([`Outcome::index`](super::Outcome::index)); an agreeing
-    /// cell's points count as its
-    /// first corner's (exact for `inside`, approximate for the binding constraints outside).
+    /// cell's points count as its first corner's (exact for `inside`, approximate for the
+    /// binding constraints outside).
     pub binding: [u64; 7],
     /// The box of the inside points (mm), if any.
     pub bbox: Option<Bounds>,
