@@ -145,27 +145,24 @@ fn workspace<'py>(
         d.set_item("volume_sampled_mm3", a.volume_sampled_mm3)?;
         d.set_item("sampled_half_width_mm3", a.sampled_half_width_mm3)?;
         d.set_item("bbox", a.bbox.as_ref().map(bounds_tuple))?;
-        match a.largest_box {
-            Some(b) => {
-                let lb = PyDict::new(py);
-                lb.set_item("min", <[f64; 3]>::from(b.min))?;
-                lb.set_item("max", <[f64; 3]>::from(b.max))?;
-                lb.set_item("volume_mm3", a.largest_box_mm3)?;
-                lb.set_item("upper_bound_mm3", a.largest_box_upper_mm3)?;
-                d.set_item("largest_box", lb)?;
-            }
-            None => d.set_item("largest_box", py.None())?,
-        }
-        match a.largest_cube {
-            Some(b) => {
-                let lc = PyDict::new(py);
-                lc.set_item("min", <[f64; 3]>::from(b.min))?;
-                lc.set_item("max", <[f64; 3]>::from(b.max))?;
-                lc.set_item("volume_mm3", a.largest_cube_mm3)?;
-                lc.set_item("upper_bound_mm3", a.largest_cube_upper_mm3)?;
-                d.set_item("largest_cube", lc)?;
-            }
-            None => d.set_item("largest_cube", py.None())?,
+        for (key, found, volume, upper) in [
+            (
+                "largest_box",
+                a.largest_box,
+                a.largest_box_mm3,
+                a.largest_box_upper_mm3,
+            ),
+            (
+                "largest_cube",
+                a.largest_cube,
+                a.largest_cube_mm3,
+                a.largest_cube_upper_mm3,
+            ),
+        ] {
+            let item = found
+                .map(|b| box_dict(py, &b, volume, Some(upper)))
+                .transpose()?;
+            d.set_item(key, item)?;
         }
         d.set_item("touches_bounds", a.touches_bounds)?;
         d.set_item(
@@ -198,25 +195,14 @@ fn workspace<'py>(
     d.set_item("volume_double_step_mm3", w.volume_double_step_mm3)?;
     d.set_item("error_estimate_mm3", w.volume_error_mm3())?;
     d.set_item("bbox", w.bbox.as_ref().map(bounds_tuple))?;
-    match w.largest_box_size() {
-        Some((b, volume)) => {
-            let lb = PyDict::new(py);
-            lb.set_item("min", <[f64; 3]>::from(b.min))?;
-            lb.set_item("max", <[f64; 3]>::from(b.max))?;
-            lb.set_item("volume_mm3", volume)?;
-            d.set_item("largest_box", lb)?;
-        }
-        None => d.set_item("largest_box", py.None())?,
-    }
-    match w.largest_cube_size() {
-        Some((b, volume)) => {
-            let lc = PyDict::new(py);
-            lc.set_item("min", <[f64; 3]>::from(b.min))?;
-            lc.set_item("max", <[f64; 3]>::from(b.max))?;
-            lc.set_item("volume_mm3", volume)?;
-            d.set_item("largest_cube", lc)?;
-        }
-        None => d.set_item("largest_cube", py.None())?,
+    for (key, found) in [
+        ("largest_box", w.largest_box_size()),
+        ("largest_cube", w.largest_cube_size()),
+    ] {
+        let item = found
+            .map(|(b, volume)| box_dict(py, &b, volume, None))
+            .transpose()?;
+        d.set_item(key, item)?;
     }
     d.set_item("touches_bounds", w.touches_bounds)?;
     d.set_item(
@@ -249,4 +235,22 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(workspace, m)?)?;
     m.add("OUTCOMES", outcome_codes())?;
     Ok(())
+}
+
+/// A box inside as a dict: `min`, `max` (mm), `volume_mm3`, and for an adaptive run
+/// `upper_bound_mm3` (no box of the lattice is larger).
+fn box_dict<'py>(
+    py: Python<'py>,
+    b: &Bounds,
+    volume_mm3: f64,
+    upper_bound_mm3: Option<f64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("min", <[f64; 3]>::from(b.min))?;
+    d.set_item("max", <[f64; 3]>::from(b.max))?;
+    d.set_item("volume_mm3", volume_mm3)?;
+    if let Some(u) = upper_bound_mm3 {
+        d.set_item("upper_bound_mm3", u)?;
+    }
+    Ok(d)
 }

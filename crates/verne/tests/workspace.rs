@@ -300,37 +300,31 @@ fn compare(m: &Machine, opts: &WorkspaceOptions, factor: usize) -> (u64, u64) {
     let g = uniform.grid;
     let grid_box =
         |p: Vector3<f64>| [0, 1, 2].map(|d| ((p[d] - g.origin[d]) / g.step).round() as usize);
-    let (lo, hi) = (grid_box(found.min), grid_box(found.max));
-    for k in lo[2]..=hi[2] {
-        for j in lo[1]..=hi[1] {
-            for i in lo[0]..=hi[0] {
-                assert_eq!(
-                    uniform_map.at(i, j, k),
-                    Outcome::Inside,
-                    "{name}: the largest box {found:?} holds a point outside"
-                );
+    // Every grid point of `b` (mm) is inside on the uniform grid; its index box.
+    let all_inside = |b: &Bounds, what: &str| {
+        let (lo, hi) = (grid_box(b.min), grid_box(b.max));
+        for k in lo[2]..=hi[2] {
+            for j in lo[1]..=hi[1] {
+                for i in lo[0]..=hi[0] {
+                    assert_eq!(
+                        uniform_map.at(i, j, k),
+                        Outcome::Inside,
+                        "{name}: the largest {what} {b:?} holds a point outside"
+                    );
+                }
             }
         }
-    }
+        (lo, hi)
+    };
+    all_inside(&found, "box");
     // The same for the largest cube.
     let (_, best_cube) = uniform.largest_cube_size().unwrap();
     let cube = adaptive.largest_cube.unwrap();
-    let (lo, hi) = (grid_box(cube.min), grid_box(cube.max));
+    let (lo, hi) = all_inside(&cube, "cube");
     assert!(
         hi[0] - lo[0] == hi[1] - lo[1] && hi[1] - lo[1] == hi[2] - lo[2],
         "{name}: a cube"
     );
-    for k in lo[2]..=hi[2] {
-        for j in lo[1]..=hi[1] {
-            for i in lo[0]..=hi[0] {
-                assert_eq!(
-                    uniform_map.at(i, j, k),
-                    Outcome::Inside,
-                    "{name}: cube {cube:?}"
-                );
-            }
-        }
-    }
     assert!(
         adaptive.largest_cube_mm3 <= best_cube * (1.0 + 1e-12)
             && best_cube <= adaptive.largest_cube_upper_mm3 * (1.0 + 1e-12),

@@ -298,39 +298,12 @@ fn run_adaptive(
                     ""
                 }
             );
-            match a.largest_box {
-                Some(b) => {
-                    let e = b.max - b.min;
-                    let _ = writeln!(
-                        text,
-                        "  largest box        {}: {} x {} x {} mm = {:.3} l (no box of the lattice is larger than {:.3} l)",
-                        range(&b),
-                        fmt_num(e.x, 3),
-                        fmt_num(e.y, 3),
-                        fmt_num(e.z, 3),
-                        a.largest_box_mm3 * 1e-6,
-                        a.largest_box_upper_mm3 * 1e-6
-                    );
-                }
-                None => {
-                    let _ = writeln!(text, "  largest box        (none with positive volume)");
-                }
-            }
-            match a.largest_cube {
-                Some(b) => {
-                    let _ = writeln!(
-                        text,
-                        "  largest cube       {}: edge {} mm = {:.3} l (no cube of the lattice is larger than {:.3} l)",
-                        range(&b),
-                        fmt_num(b.max.x - b.min.x, 3),
-                        a.largest_cube_mm3 * 1e-6,
-                        a.largest_cube_upper_mm3 * 1e-6
-                    );
-                }
-                None => {
-                    let _ = writeln!(text, "  largest cube       (none with positive volume)");
-                }
-            }
+            let found = |b: Option<Bounds>, v: f64, upper: f64| b.map(|b| (b, v, Some(upper)));
+            largest_box_lines(
+                &mut text,
+                found(a.largest_box, a.largest_box_mm3, a.largest_box_upper_mm3),
+                found(a.largest_cube, a.largest_cube_mm3, a.largest_cube_upper_mm3),
+            );
         } else {
             any_empty = true;
             let _ = writeln!(text, "  no point inside");
@@ -607,6 +580,56 @@ fn fmt_num(v: f64, decimals: usize) -> String {
     if s == "-0" { "0".into() } else { s }
 }
 
+/// The summary's lines of the largest box and cube inside: (corners in mm, volume in mm^3, and
+/// for an adaptive run the volume none of the lattice exceeds).
+fn largest_box_lines(
+    out: &mut String,
+    largest_box: Option<(Bounds, f64, Option<f64>)>,
+    largest_cube: Option<(Bounds, f64, Option<f64>)>,
+) {
+    let bound = |what: &str, upper: Option<f64>| {
+        upper.map_or(String::new(), |u| {
+            format!(
+                " (no {what} of the lattice is larger than {:.3} l)",
+                u * 1e-6
+            )
+        })
+    };
+    match largest_box {
+        Some((b, v, upper)) => {
+            let e = b.max - b.min;
+            let _ = writeln!(
+                out,
+                "  largest box        {}: {} x {} x {} mm = {:.3} l{}",
+                range(&b),
+                fmt_num(e.x, 3),
+                fmt_num(e.y, 3),
+                fmt_num(e.z, 3),
+                v * 1e-6,
+                bound("box", upper)
+            );
+        }
+        None => {
+            let _ = writeln!(out, "  largest box        (none with positive volume)");
+        }
+    }
+    match largest_cube {
+        Some((b, v, upper)) => {
+            let _ = writeln!(
+                out,
+                "  largest cube       {}: edge {} mm = {:.3} l{}",
+                range(&b),
+                fmt_num(b.max.x - b.min.x, 3),
+                v * 1e-6,
+                bound("cube", upper)
+            );
+        }
+        None => {
+            let _ = writeln!(out, "  largest cube       (none with positive volume)");
+        }
+    }
+}
+
 fn range(b: &Bounds) -> String {
     format!(
         "x [{}, {}]  y [{}, {}]  z [{}, {}] mm",
@@ -664,37 +687,12 @@ fn describe(out: &mut String, s: &WorkspaceSummary, elapsed: Duration) {
             let _ = writeln!(out, "  bounding box       (empty workspace)");
         }
     }
-    match s.largest_box_size() {
-        Some((b, v)) => {
-            let e = b.max - b.min;
-            let _ = writeln!(
-                out,
-                "  largest box        {}: {} x {} x {} mm = {:.3} l",
-                range(&b),
-                fmt_num(e.x, 3),
-                fmt_num(e.y, 3),
-                fmt_num(e.z, 3),
-                v * 1e-6
-            );
-        }
-        None => {
-            let _ = writeln!(out, "  largest box        (none with positive volume)");
-        }
-    }
-    match s.largest_cube_size() {
-        Some((b, v)) => {
-            let _ = writeln!(
-                out,
-                "  largest cube       {}: edge {} mm = {:.3} l",
-                range(&b),
-                fmt_num(b.max.x - b.min.x, 3),
-                v * 1e-6
-            );
-        }
-        None => {
-            let _ = writeln!(out, "  largest cube       (none with positive volume)");
-        }
-    }
+    let found = |b: Option<(Bounds, f64)>| b.map(|(b, v)| (b, v, None));
+    largest_box_lines(
+        out,
+        found(s.largest_box_size()),
+        found(s.largest_cube_size()),
+    );
     if s.touches_bounds {
         let _ = writeln!(
             out,

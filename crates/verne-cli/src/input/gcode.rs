@@ -206,7 +206,10 @@ impl FieldRows for TcpRows {
         };
         let r = &p.row;
         row.field(r.line);
-        row.optional(r.n.map(|n| format!("N{n}")));
+        match r.n {
+            Some(n) => row.field(format_args!("N{n}")),
+            None => row.optional(None::<u64>),
+        }
         row.field(r.kind.as_str());
         row.field(r.motion.as_str());
         row.optional(r.feed_per_min.filter(|_| r.motion == Motion::Feed));

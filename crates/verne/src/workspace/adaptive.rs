@@ -228,21 +228,19 @@ pub fn compute_adaptive(
         };
         let bbox = GridBox { lo, hi };
         let r = refined_largest_box(coarse_n, &refined.coarse_inside, s0, bbox, &inside_at);
-        if let Some((g, v)) = r.found {
-            summary.largest_box = Some(Bounds {
-                min: point(g.lo),
-                max: point(g.hi),
-            });
-            summary.largest_box_mm3 = v * h3;
-        }
+        // (corners in mm, volume in mm^3) of a box of fine indices and steps^3.
+        let in_mm = |found: Option<(GridBox, f64)>| {
+            found.map_or((None, 0.0), |(g, v)| {
+                let b = Bounds {
+                    min: point(g.lo),
+                    max: point(g.hi),
+                };
+                (Some(b), v * h3)
+            })
+        };
+        (summary.largest_box, summary.largest_box_mm3) = in_mm(r.found);
+        (summary.largest_cube, summary.largest_cube_mm3) = in_mm(r.cube);
         summary.largest_box_upper_mm3 = r.upper * h3;
-        if let Some((g, v)) = r.cube {
-            summary.largest_cube = Some(Bounds {
-                min: point(g.lo),
-                max: point(g.hi),
-            });
-            summary.largest_cube_mm3 = v * h3;
-        }
         summary.largest_cube_upper_mm3 = r.cube_upper * h3;
         summary.box_points_examined = r.examined;
     }
