@@ -11,5 +11,6 @@ pub mod dd;
 pub mod interval;
 pub mod poly;
 pub mod scalar;
+pub mod splitmix;
 pub(crate) mod test_rng;
 pub mod trig;

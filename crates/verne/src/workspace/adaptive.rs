@@ -25,6 +25,7 @@
 //! with 99.7 % confidence, whatever the shape: `volume_sampled_mm3` +- `sampled_half_width_mm3`,
 //! about 0.004 % of the volume at 1 mm on the default machine for [`BOUNDARY_SAMPLES`] points.
 
+use crate::math::splitmix::{splitmix64, unit_offsets};
 use crate::par::*;
 use crate::spec::Machine;
 
@@ -711,20 +712,10 @@ impl Sampler<'_> {
         if splitmix64(&mut state) > self.threshold {
             return None;
         }
-        // Three uniform offsets in [0, 1), from 53 bits each.
-        let u = [0; 3].map(|_| (splitmix64(&mut state) >> 11) as f64 * (1.0 / (1u64 << 53) as f64));
+        let u = unit_offsets::<3>(&mut state);
         let p = [0, 1, 2].map(|d| c[d] as f64 + u[d]);
         Some((self.classify_point)(p) == INSIDE)
     }
-}
-
-/// SplitMix64 (Steele, Lea, Flood 2014): a well-mixed 64-bit hash of the state, advanced.
-fn splitmix64(state: &mut u64) -> u64 {
-    *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    let mut z = *state;
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
 }
 
 /// The eight corners of the cell of size `s` at `c`.
