@@ -631,6 +631,181 @@ fn largest_rectangle_lies_in_the_workspace() {
     }
 }
 
+/// The presets and machines that are not: an orthoglide with unequal struts and shifted
+/// strokes, a biglide whose guides are not parallel, an orthoglide designed for other bounds.
+fn workspace_machines() -> Vec<GliderSpec> {
+    let mut specs = presets();
+    let mut o = GliderSpec::preset("orthoglide").unwrap();
+    o.name = "orthoglide, l2 = 0.8 l1".into();
+    o.l2 = 0.8 * o.l1;
+    o.rho2_range = [o.rho2_range[0] - 0.1, o.rho2_range[1] - 0.25];
+    let mut b = GliderSpec::preset("biglide2").unwrap();
+    b.name = "biglide2, guides at 90 and 80 deg".into();
+    b.alpha2 = 80f64.to_radians();
+    specs.extend([o, b]);
+    // `verne design --bounds 1/2,2`'s orthoglide.
+    specs.extend(architecture_spec(Architecture::Orthoglide, 1.0, [0.5, 2.0]));
+    specs
+}
+
+/// The adaptive grid classifies every node as the uniform grid does, so the region, its area
+/// and the largest rectangle and square are the same, on machines other than the presets, in
+/// both assembly modes and three working modes, with and without the amplification bounds, the
+/// grid turned or not, and a grid too coarse for adaptive sampling by default; it classifies
+/// fewer nodes.
+#[test]
+fn adaptive_workspace_equals_the_uniform_grid() {
+    let mut cases = 0;
+    for spec in workspace_machines() {
+        for (mode, assembly, bounds, angle, nodes) in [
+            // `verne workspace`'s default grid, and `verne design`'s (both orientations).
+            ("++", Branch::Plus, Some(PAPER_LAMBDA_BOUNDS), 0.0, 801),
+            ("++", Branch::Plus, Some(PAPER_LAMBDA_BOUNDS), 0.0, 1201),
+            (
+                "++",
+                Branch::Plus,
+                Some(PAPER_LAMBDA_BOUNDS),
+                FRAC_PI_4,
+                1201,
+            ),
+            ("++", Branch::Plus, None, 0.3, 601),
+            ("++", Branch::Minus, None, 0.0, 601),
+            ("+-", Branch::Plus, Some([0.5, 2.0]), 0.0, 401),
+            (
+                "-+",
+                Branch::Minus,
+                Some(PAPER_LAMBDA_BOUNDS),
+                FRAC_PI_4,
+                257,
+            ),
+        ] {
+            let opts = |sampling| WorkspaceOptions {
+                mode: WorkingMode::parse(mode).unwrap(),
+                assembly,
+                lambda_bounds: bounds,
+                nodes,
+                frame_angle: angle,
+                seed: None,
+                sampling,
+            };
+            let what = format!(
+                "{} {mode} {assembly:?} {bounds:?} {angle} {nodes}",
+                spec.name
+            );
+            let uniform = sample_workspace(&spec, &opts(Sampling::Uniform));
+            let adaptive = sample_workspace(&spec, &opts(Sampling::Adaptive));
+            let differ: Vec<_> = (0..uniform.class.len())
+                .filter(|&k| uniform.class[k] != adaptive.class[k])
+                .map(|k| {
+                    (
+                        k % uniform.nx,
+                        k / uniform.nx,
+                        uniform.class[k],
+                        adaptive.class[k],
+                    )
+                })
+                .collect();
+            assert!(
+                differ.is_empty(),
+                "{what}: {} nodes differ, {:?}",
+                differ.len(),
+                &differ[..differ.len().min(8)]
+            );
+            assert!(uniform.region == adaptive.region, "{what}");
+            assert_eq!(uniform.seed, adaptive.seed, "{what}");
+            assert_eq!(uniform.region_estimate, adaptive.region_estimate, "{what}");
+            assert_eq!(largest_rectangle(&uniform), largest_rectangle(&adaptive));
+            assert_eq!(largest_square(&uniform), largest_square(&adaptive));
+            assert_eq!(uniform.coarse_step, None);
+            assert_eq!(adaptive.coarse_step, Some(8.0 * adaptive.step));
+            assert_eq!(
+                uniform.classified,
+                uniform.nx * uniform.ny + uniform.region_estimate.boundary_cells
+            );
+            if uniform.class.contains(&NodeClass::Admissible) {
+                cases += 1;
+                assert!(
+                    adaptive.classified < uniform.classified / 2,
+                    "{what}: {} of {}",
+                    adaptive.classified,
+                    uniform.classified
+                );
+            }
+            // Auto is uniform below 513 nodes and adaptive from there.
+            let auto = sample_workspace(&spec, &opts(Sampling::Auto));
+            assert_eq!(auto.coarse_step.is_some(), nodes >= 513, "{what}");
+            assert_eq!(auto.class, uniform.class, "{what}");
+        }
+    }
+    assert!(cases >= 20, "{cases} cases with a workspace");
+}
+
+/// The cost of the adaptive grid grows with the boundary: about 2x a halving of the step (the
+/// uniform grid's 4x), from 401 to 3201 nodes.
+#[test]
+fn adaptive_cost_grows_with_the_boundary() {
+    let spec = GliderSpec::preset("orthoglide").unwrap();
+    let cost = |nodes| {
+        sample_workspace(
+            &spec,
+            &WorkspaceOptions {
+                nodes,
+                sampling: Sampling::Adaptive,
+                ..WorkspaceOptions::default()
+            },
+        )
+        .classified as f64
+    };
+    let costs = [401, 801, 1601, 3201].map(cost);
+    for w in costs.windows(2) {
+        let ratio = w[1] / w[0];
+        assert!((1.6..2.6).contains(&ratio), "{costs:?}");
+    }
+}
+
+/// The region's area lies in its bracket, whose width shrinks with the step; the sampled
+/// estimates of a coarse and a fine grid agree within their half-widths, and the fine grid's
+/// node count within the coarse grid's bracket.
+#[test]
+fn region_area_bracket_and_sampled_estimate() {
+    for spec in workspace_machines() {
+        let run = |nodes| {
+            sample_workspace(
+                &spec,
+                &WorkspaceOptions {
+                    nodes,
+                    ..WorkspaceOptions::default()
+                },
+            )
+        };
+        let (coarse, fine) = (run(201), run(1601));
+        let name = &spec.name;
+        for g in [&coarse, &fine] {
+            let e = g.region_estimate;
+            assert!(
+                e.lo > 0.0 && e.lo <= g.region_area() && g.region_area() <= e.hi,
+                "{name} {e:?} {} {}",
+                g.region_area(),
+                g.nx
+            );
+            assert!(e.lo <= e.sampled && e.sampled <= e.hi, "{name} {e:?}");
+            assert!(
+                e.half_width > 0.0 && e.half_width <= e.hi - e.lo,
+                "{name} {e:?}"
+            );
+            let cell = g.step * g.step;
+            assert!(((e.hi - e.lo) / cell - e.boundary_cells as f64).abs() < 1e-6);
+        }
+        let (c, f) = (coarse.region_estimate, fine.region_estimate);
+        assert!(f.hi - f.lo < 0.25 * (c.hi - c.lo), "{name} {c:?} {f:?}");
+        assert!(c.lo <= f.sampled && f.sampled <= c.hi, "{name} {c:?} {f:?}");
+        assert!(
+            (c.sampled - f.sampled).abs() <= c.half_width + f.half_width,
+            "{name} {c:?} {f:?}"
+        );
+    }
+}
+
 #[test]
 fn empty_workspace_is_empty_not_an_error() {
     // Joint box entirely beyond reach: C and D more than 2L apart.

@@ -30,8 +30,24 @@ impl Amplification {
     /// Whether both factors satisfy lo < lambda < hi (eq. (4), Wenger 2001, with lo = 1/3 and
     /// hi = 3), with the slack [`LAMBDA_BOUND_SLACK`](super::tolerance::LAMBDA_BOUND_SLACK).
     pub fn within(&self, lo: f64, hi: f64) -> bool {
+        self.outside(lo, hi) == (false, false)
+    }
+
+    /// Which bound of [`within`](Self::within) fails: (lambda_min below lo, lambda_max above
+    /// hi); a factor that is not a number fails its bound.
+    pub fn outside(&self, lo: f64, hi: f64) -> (bool, bool) {
         let s = super::tolerance::LAMBDA_BOUND_SLACK;
-        self.lambda_min >= lo * (1.0 - s) && self.lambda_max <= hi * (1.0 + s)
+        use std::cmp::Ordering::{Equal, Greater, Less};
+        (
+            !matches!(
+                self.lambda_min.partial_cmp(&(lo * (1.0 - s))),
+                Some(Greater | Equal)
+            ),
+            !matches!(
+                self.lambda_max.partial_cmp(&(hi * (1.0 + s))),
+                Some(Less | Equal)
+            ),
+        )
     }
 }
 

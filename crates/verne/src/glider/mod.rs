@@ -1,6 +1,7 @@
 //! Planar 2-DOF glider mechanisms of the comparative study (Wenger, Gosselin, Chablat 2001):
 //! biglide1, biglide2 and orthoglide, as a library. Conventions in docs/gliders.md.
 
+pub mod adaptive;
 pub mod design;
 pub mod jacobian;
 pub mod kinematics;
@@ -28,6 +29,6 @@ pub use verdict::{
     verdict,
 };
 pub use workspace::{
-    NodeClass, PAPER_LAMBDA_BOUNDS, Rectangle, WorkspaceGrid, WorkspaceOptions, largest_rectangle,
-    largest_square, sample_workspace,
+    AreaEstimate, NodeClass, PAPER_LAMBDA_BOUNDS, Rectangle, Sampling, WorkspaceGrid,
+    WorkspaceOptions, largest_rectangle, largest_square, sample_workspace,
 };

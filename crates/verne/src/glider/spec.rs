@@ -225,9 +225,21 @@ impl GliderSpec {
     /// Whether rho lies in the joint box (with the slack of
     /// [`JOINT_LIMIT_REL`](super::tolerance::JOINT_LIMIT_REL)).
     pub fn within_limits(&self, rho: Vector2<f64>) -> bool {
+        self.limits_passed(rho) == 0
+    }
+
+    /// The joint limits `rho` passes (beyond the slack of [`within_limits`](Self::within_limits)),
+    /// a bit set: rho1 below its range 1, above 2; rho2 below 4, above 8. A joint that is not a
+    /// number passes both of its limits.
+    pub fn limits_passed(&self, rho: Vector2<f64>) -> u8 {
         let slack = super::tolerance::JOINT_LIMIT_REL * self.l1;
-        let inside = |v: f64, [lo, hi]: [f64; 2]| v >= lo - slack && v <= hi + slack;
-        inside(rho.x, self.rho1_range) && inside(rho.y, self.rho2_range)
+        use std::cmp::Ordering::{Equal, Greater, Less};
+        let passed = |v: f64, [lo, hi]: [f64; 2]| {
+            let below = !matches!(v.partial_cmp(&(lo - slack)), Some(Greater | Equal));
+            let above = !matches!(v.partial_cmp(&(hi + slack)), Some(Less | Equal));
+            u8::from(below) | u8::from(above) << 1
+        };
+        passed(rho.x, self.rho1_range) | passed(rho.y, self.rho2_range) << 2
     }
 
     /// This mechanism with every length multiplied by `k` (angles unchanged).

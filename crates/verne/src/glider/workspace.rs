@@ -4,18 +4,23 @@
 //! largest square inside it.
 //!
 //! The grid may be rotated by `frame_angle` from the mechanism frame; rectangles are
-//! axis-aligned in the grid frame. Every node is classified independently (in parallel with
-//! rayon, collected in order), then the flood fill and the rectangle search run sequentially, so
-//! the result is identical whatever the thread count.
+//! axis-aligned in the grid frame. Every node is classified (uniform sampling), or only the
+//! nodes near the boundaries between classes ([`super::adaptive`], the default on fine grids),
+//! in parallel with rayon, collected in order; then the flood fill and the rectangle search run
+//! sequentially, so the result is identical whatever the thread count. The region's area comes
+//! with a bracket (the cells with all four corners in the region, and those with any) and an
+//! estimate from one pseudo-random point in each cell between, bounded by Hoeffding's
+//! inequality.
 
-use std::collections::VecDeque;
-
+use crate::math::splitmix::unit_offsets;
 use crate::par::*;
 use nalgebra::{Point2, Rotation2, Vector2};
 
+use super::adaptive::{COARSE_FACTOR, MIN_COARSE_CELLS, classify_adaptive};
 use super::jacobian::{amplification, is_parallel_singular, is_serial_singular};
 use super::kinematics::{
     Branch, WorkingMode, assembly_of, forward_kinematics_in_mode, inverse_kinematics_in_mode,
+    strut_root,
 };
 use super::spec::GliderSpec;
 
@@ -27,6 +32,34 @@ const WINDOW_JOINT_SAMPLES: usize = 129;
 
 /// Margin added on each side of that window, as a fraction of its larger extent.
 const WINDOW_MARGIN_REL: f64 = 0.03;
+
+/// The confidence of the sampled area's half-width: 1 - delta = 99.7 %.
+pub const SAMPLED_CONFIDENCE_DELTA: f64 = 0.003;
+
+/// Which nodes of the grid are classified.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Sampling {
+    /// Adaptive when the coarse grid ([`COARSE_FACTOR`] steps) has at least
+    /// [`MIN_COARSE_CELLS`] cells along the window's longer side (801 nodes do), else uniform.
+    #[default]
+    Auto,
+    /// Every node.
+    Uniform,
+    /// A coarse grid of [`COARSE_FACTOR`] steps refined where the class changes
+    /// ([`super::adaptive`]).
+    Adaptive,
+}
+
+impl Sampling {
+    /// Whether a grid of `nodes` along its longer side is sampled adaptively.
+    pub fn is_adaptive(self, nodes: usize) -> bool {
+        match self {
+            Sampling::Auto => nodes.saturating_sub(1) >= COARSE_FACTOR * MIN_COARSE_CELLS,
+            Sampling::Uniform => false,
+            Sampling::Adaptive => true,
+        }
+    }
+}
 
 /// How to sample a workspace.
 #[derive(Debug, Clone, PartialEq)]
@@ -44,6 +77,8 @@ pub struct WorkspaceOptions {
     /// A point of the wanted t-connected region; `None`: the forward kinematics, in `assembly`,
     /// of the centre of the joint box.
     pub seed: Option<Point2<f64>>,
+    /// Which nodes are classified.
+    pub sampling: Sampling,
 }
 
 impl Default for WorkspaceOptions {
@@ -55,12 +90,14 @@ impl Default for WorkspaceOptions {
             nodes: 801,
             frame_angle: 0.0,
             seed: None,
+            sampling: Sampling::Auto,
         }
     }
 }
 
 /// Why a grid node is, or is not, in the workspace; checked in this order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[repr(u8)]
 pub enum NodeClass {
     /// The working mode cannot reach the point (a strut does not reach its guide).
     Unreachable,
@@ -93,6 +130,29 @@ pub struct WorkspaceGrid {
     pub region: Vec<bool>,
     /// The seed node, if the seed fell on an admissible node.
     pub seed: Option<(usize, usize)>,
+    /// The coarse step of an adaptive grid; `None` for a uniform one.
+    pub coarse_step: Option<f64>,
+    /// Points classified: the nodes classified (all of them on a uniform grid), plus those of
+    /// the refinement past the window, plus the area's sample points.
+    pub classified: usize,
+    /// The region's area bracketed and estimated from its boundary cells.
+    pub region_estimate: AreaEstimate,
+}
+
+/// The area of the t-connected region from the cells of the grid (squares of four nodes).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct AreaEstimate {
+    /// Area of the cells whose four corners are in the region, and of those with any corner in
+    /// it: the true area lies between wherever no feature hides inside a cell.
+    pub lo: f64,
+    pub hi: f64,
+    /// Cells with some corners in the region and some not.
+    pub boundary_cells: usize,
+    /// `lo` plus the boundary cells' area times the share of them whose pseudo-random point
+    /// (one a cell, placed by a hash of the cell) is admissible (taken as in the region: the
+    /// cell touches it); and the half-width of its 99.7 % confidence interval (Hoeffding).
+    pub sampled: f64,
+    pub half_width: f64,
 }
 
 /// A rectangle, axis-aligned in a frame rotated by `angle` from the mechanism frame.
@@ -159,25 +219,67 @@ impl WorkspaceGrid {
 
 /// Classifies one point of the mechanism frame.
 pub fn classify(spec: &GliderSpec, p: Point2<f64>, opts: &WorkspaceOptions) -> NodeClass {
+    classify_binding(spec, p, opts).0
+}
+
+/// The class of a point and which constraint binds there, a bit set: for `Unreachable`, the
+/// struts that do not reach (1, 2); for `OutOfRange`, the limits passed (rho1 below, above,
+/// rho2 below, above: 1, 2, 4, 8); for `OutOfBounds`, lambda_min below LO (1), lambda_max above
+/// HI (2), no factors (4); 0 otherwise. The adaptive grid refines a cell whose corners differ
+/// in either: the thin wedge of the joint box's image between two limits lies in cells whose
+/// corners are all out of range, each past another limit.
+fn classify_binding(spec: &GliderSpec, p: Point2<f64>, opts: &WorkspaceOptions) -> (NodeClass, u8) {
     let Some(rho) = inverse_kinematics_in_mode(spec, p, opts.mode) else {
-        return NodeClass::Unreachable;
+        let misses = |o, u, l, branch| u8::from(strut_root(o, u, l, p, branch).is_none());
+        return (
+            NodeClass::Unreachable,
+            misses(spec.a(), spec.u1(), spec.l1, opts.mode.strut1)
+                | misses(spec.b(), spec.u2(), spec.l2, opts.mode.strut2) << 1,
+        );
     };
-    if !spec.within_limits(rho) {
-        return NodeClass::OutOfRange;
+    let passed = spec.limits_passed(rho);
+    if passed != 0 {
+        return (NodeClass::OutOfRange, passed);
     }
     if is_serial_singular(spec, p, rho) || is_parallel_singular(spec, p, rho) {
-        return NodeClass::Singular;
+        return (NodeClass::Singular, 0);
     }
     if assembly_of(spec, p, rho) != opts.assembly {
-        return NodeClass::OtherAssembly;
+        return (NodeClass::OtherAssembly, 0);
     }
     if let Some([lo, hi]) = opts.lambda_bounds {
         match amplification(spec, p, rho) {
             Some(a) if a.within(lo, hi) => {}
-            _ => return NodeClass::OutOfBounds,
+            Some(a) => {
+                let (below, above) = a.outside(lo, hi);
+                return (
+                    NodeClass::OutOfBounds,
+                    u8::from(below) | u8::from(above) << 1,
+                );
+            }
+            None => return (NodeClass::OutOfBounds, 4),
         }
     }
-    NodeClass::Admissible
+    (NodeClass::Admissible, 0)
+}
+
+/// A node's class and binding constraints in one byte (class in the low three bits), for the
+/// adaptive grid; [`node_class_of_key`] takes the class back.
+fn refinement_key(spec: &GliderSpec, p: Point2<f64>, opts: &WorkspaceOptions) -> u8 {
+    let (class, binding) = classify_binding(spec, p, opts);
+    class as u8 | binding << 3
+}
+
+fn node_class_of_key(key: u8) -> NodeClass {
+    const CLASSES: [NodeClass; 6] = [
+        NodeClass::Unreachable,
+        NodeClass::OutOfRange,
+        NodeClass::Singular,
+        NodeClass::OtherAssembly,
+        NodeClass::OutOfBounds,
+        NodeClass::Admissible,
+    ];
+    CLASSES[(key & 7) as usize]
 }
 
 /// Bounding box, in the frame rotated by `frame_angle`, of the forward kinematics in one
@@ -210,8 +312,9 @@ pub fn joint_box_image_bounds(
 }
 
 /// Samples the workspace of one working mode: the window is the image of the joint box (plus a
-/// margin), every node is classified, then the t-connected region of the seed is flood-filled
-/// (4-connectivity through admissible nodes).
+/// margin), the nodes are classified (every one, or adaptively: [`Sampling`]), then the
+/// t-connected region of the seed is flood-filled (4-connectivity through admissible nodes)
+/// and its area estimated ([`AreaEstimate`]).
 pub fn sample_workspace(spec: &GliderSpec, opts: &WorkspaceOptions) -> WorkspaceGrid {
     let empty = WorkspaceGrid {
         frame_angle: opts.frame_angle,
@@ -222,6 +325,9 @@ pub fn sample_workspace(spec: &GliderSpec, opts: &WorkspaceOptions) -> Workspace
         class: Vec::new(),
         region: Vec::new(),
         seed: None,
+        coarse_step: None,
+        classified: 0,
+        region_estimate: AreaEstimate::default(),
     };
     let Some((lo, hi)) =
         joint_box_image_bounds(spec, opts.assembly, opts.frame_angle, WINDOW_JOINT_SAMPLES)
@@ -243,10 +349,19 @@ pub fn sample_workspace(spec: &GliderSpec, opts: &WorkspaceOptions) -> Workspace
         ..empty
     };
     let g = &grid;
-    grid.class = (0..ny)
-        .into_par_iter()
-        .flat_map_iter(|j| (0..nx).map(move |i| classify(spec, g.node(i, j), opts)))
-        .collect();
+    let (class, classified, coarse_step) = if opts.sampling.is_adaptive(nodes) {
+        let key = |i: usize, j: usize| refinement_key(spec, g.node(i, j), opts);
+        let (keys, n) = classify_adaptive(nx, ny, COARSE_FACTOR, &key);
+        let class = keys.into_iter().map(node_class_of_key).collect();
+        (class, n, Some(step * COARSE_FACTOR as f64))
+    } else {
+        let class = (0..ny)
+            .into_par_iter()
+            .flat_map_iter(|j| (0..nx).map(move |i| classify(spec, g.node(i, j), opts)))
+            .collect();
+        (class, nx * ny, None)
+    };
+    (grid.class, grid.classified, grid.coarse_step) = (class, classified, coarse_step);
 
     let seed_point = opts.seed.or_else(|| {
         let centre = Vector2::new(
@@ -267,27 +382,101 @@ pub fn sample_workspace(spec: &GliderSpec, opts: &WorkspaceOptions) -> Workspace
             }
         }
     }
+    let (estimate, sampled) = estimate_region_area(spec, &grid, opts);
+    grid.region_estimate = estimate;
+    grid.classified += sampled;
     grid
 }
 
-fn flood_fill(grid: &mut WorkspaceGrid, i: usize, j: usize) {
+/// The region's [`AreaEstimate`], and the points classified for it (one a boundary cell).
+fn estimate_region_area(
+    spec: &GliderSpec,
+    grid: &WorkspaceGrid,
+    opts: &WorkspaceOptions,
+) -> (AreaEstimate, usize) {
     let (nx, ny) = (grid.nx, grid.ny);
-    let mut queue = VecDeque::from([(i, j)]);
-    grid.region[j * nx + i] = true;
-    while let Some((i, j)) = queue.pop_front() {
-        let neighbours = [
-            (i.wrapping_sub(1), j),
-            (i + 1, j),
-            (i, j.wrapping_sub(1)),
-            (i, j + 1),
-        ];
-        for (a, b) in neighbours {
-            if a < nx && b < ny {
-                let k = b * nx + a;
-                if !grid.region[k] && grid.class[k] == NodeClass::Admissible {
-                    grid.region[k] = true;
-                    queue.push_back((a, b));
+    if nx < 2 || ny < 2 {
+        return (AreaEstimate::default(), 0);
+    }
+    let rotation = Rotation2::new(grid.frame_angle);
+    // Per row of cells: (cells all in the region, boundary cells, their points admissible).
+    let (full, boundary, admissible) = (0..ny - 1)
+        .into_par_iter()
+        .map(|j| {
+            let mut counts = (0usize, 0usize, 0usize);
+            for i in 0..nx - 1 {
+                let k = j * nx + i;
+                let inside = [k, k + 1, k + nx, k + nx + 1]
+                    .iter()
+                    .filter(|&&c| grid.region[c])
+                    .count();
+                match inside {
+                    4 => counts.0 += 1,
+                    0 => {}
+                    _ => {
+                        counts.1 += 1;
+                        let mut state = k as u64;
+                        let [u, v] = unit_offsets::<2>(&mut state);
+                        let q = grid.origin + Vector2::new(i as f64 + u, j as f64 + v) * grid.step;
+                        if classify(spec, rotation * q, opts) == NodeClass::Admissible {
+                            counts.2 += 1;
+                        }
+                    }
                 }
+            }
+            counts
+        })
+        .reduce(|| (0, 0, 0), |a, b| (a.0 + b.0, a.1 + b.1, a.2 + b.2));
+    let cell = grid.step * grid.step;
+    let mut e = AreaEstimate {
+        lo: full as f64 * cell,
+        hi: (full + boundary) as f64 * cell,
+        boundary_cells: boundary,
+        sampled: full as f64 * cell,
+        half_width: 0.0,
+    };
+    if boundary > 0 {
+        let share = admissible as f64 / boundary as f64;
+        // Hoeffding: P(|share - mean| >= t) <= 2 exp(-2 n t^2) = delta.
+        let t = ((2.0 / SAMPLED_CONFIDENCE_DELTA).ln() / (2.0 * boundary as f64)).sqrt();
+        e.sampled += share * boundary as f64 * cell;
+        e.half_width = t.min(1.0) * boundary as f64 * cell;
+    }
+    (e, boundary)
+}
+
+/// Marks the admissible nodes 4-connected to (i, j) as the region, a row's run of them at a
+/// time (scanline fill: each run is marked once, then the rows above and below are searched
+/// for runs that touch it), so the cost follows the region's rows, in memory order.
+fn flood_fill(grid: &mut WorkspaceGrid, i: usize, j: usize) {
+    let nx = grid.nx;
+    let open = |g: &WorkspaceGrid, k: usize| !g.region[k] && g.class[k] == NodeClass::Admissible;
+    let mut seeds = vec![(i, j)];
+    while let Some((i, j)) = seeds.pop() {
+        let row = j * nx;
+        if !open(grid, row + i) {
+            continue;
+        }
+        let (mut lo, mut hi) = (i, i);
+        while lo > 0 && open(grid, row + lo - 1) {
+            lo -= 1;
+        }
+        while hi + 1 < nx && open(grid, row + hi + 1) {
+            hi += 1;
+        }
+        grid.region[row + lo..=row + hi].fill(true);
+        // One seed per run of open nodes in the rows next to this run.
+        for next in [j.wrapping_sub(1), j + 1] {
+            if next >= grid.ny {
+                continue;
+            }
+            let mut in_run = false;
+            for a in lo..=hi {
+                let here = open(grid, next * nx + a);
+                if here && !in_run {
+                    seeds.push((a, next));
+                }
+                in_run = here;
             }
         }
     }
@@ -335,23 +524,93 @@ pub fn largest_rectangle(grid: &WorkspaceGrid) -> Option<Rectangle> {
 /// first found). `None` if the region is empty.
 pub fn largest_square(grid: &WorkspaceGrid) -> Option<Rectangle> {
     let (nx, ny) = (grid.nx, grid.ny);
-    let mut side = vec![0usize; nx * ny];
+    // The side ending at each node of the previous row and of this one.
+    let (mut above, mut side) = (vec![0usize; nx], vec![0usize; nx]);
     let mut best: Option<(usize, usize, usize)> = None; // (side in nodes, i1, j1)
     for j in 0..ny {
         for i in 0..nx {
-            let k = j * nx + i;
-            if !grid.region[k] {
-                continue;
-            }
-            side[k] = if i == 0 || j == 0 {
+            side[i] = if !grid.region[j * nx + i] {
+                0
+            } else if i == 0 || j == 0 {
                 1
             } else {
-                1 + side[k - 1].min(side[k - nx]).min(side[k - nx - 1])
+                1 + side[i - 1].min(above[i]).min(above[i - 1])
             };
-            if best.is_none_or(|b| side[k] > b.0) {
-                best = Some((side[k], i, j));
+            if side[i] > 0 && best.is_none_or(|b| side[i] > b.0) {
+                best = Some((side[i], i, j));
+            }
+        }
+        std::mem::swap(&mut above, &mut side);
+    }
+    best.map(|(s, i1, j1)| grid.rectangle(i1 + 1 - s, i1, j1 + 1 - s, j1))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::test_rng::lcg;
+
+    /// The scanline fill marks what a breadth-first search through 4-neighbours marks, on
+    /// random mazes (spirals, pockets, runs that touch several runs above and below).
+    #[test]
+    fn scanline_fill_equals_breadth_first_search() {
+        let mut rand = lcg(7);
+        for (nx, ny, open_share) in [
+            (1, 1, 1.0),
+            (7, 1, 0.8),
+            (1, 9, 0.8),
+            (40, 30, 0.6),
+            (97, 61, 0.55),
+        ] {
+            for _ in 0..20 {
+                let class: Vec<NodeClass> = (0..nx * ny)
+                    .map(|_| {
+                        if rand() < open_share {
+                            NodeClass::Admissible
+                        } else {
+                            NodeClass::OutOfBounds
+                        }
+                    })
+                    .collect();
+                let (i, j) = ((rand() * nx as f64) as usize, (rand() * ny as f64) as usize);
+                let mut grid = WorkspaceGrid {
+                    frame_angle: 0.0,
+                    origin: Point2::origin(),
+                    step: 1.0,
+                    nx,
+                    ny,
+                    class,
+                    region: vec![false; nx * ny],
+                    seed: None,
+                    coarse_step: None,
+                    classified: 0,
+                    region_estimate: AreaEstimate::default(),
+                };
+                let mut expected = vec![false; nx * ny];
+                if grid.class[j * nx + i] == NodeClass::Admissible {
+                    flood_fill(&mut grid, i, j);
+                    let mut queue = std::collections::VecDeque::from([(i, j)]);
+                    expected[j * nx + i] = true;
+                    while let Some((a, b)) = queue.pop_front() {
+                        for (c, d) in [
+                            (a.wrapping_sub(1), b),
+                            (a + 1, b),
+                            (a, b.wrapping_sub(1)),
+                            (a, b + 1),
+                        ] {
+                            if c < nx
+                                && d < ny
+                                && !expected[d * nx + c]
+                                && grid.class[d * nx + c] == NodeClass::Admissible
+                            {
+                                expected[d * nx + c] = true;
+                                queue.push_back((c, d));
+                            }
+                        }
+                    }
+                }
+                assert_eq!(grid.region, expected, "{nx} x {ny} from ({i}, {j})");
             }
         }
     }
-    best.map(|(s, i1, j1)| grid.rectangle(i1 + 1 - s, i1, j1 + 1 - s, j1))
 }
