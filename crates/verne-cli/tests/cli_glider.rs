@@ -591,3 +591,87 @@ fn modes_plot_draws_every_branch_of_a_glider() {
     assert!(picture.contains("S = largest square") && !picture.contains("(dashed)"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `verne workspace -m GLIDER`: the adaptive grid writes the uniform grid's points CSV byte
+/// for byte, and the same summary but for the count of points classified (fewer); the default
+/// at 801 nodes is adaptive; the VERNE machine's options are refused, not ignored.
+#[test]
+fn glider_workspace_adaptive_writes_what_the_uniform_grid_writes() {
+    let dir = std::env::temp_dir().join(format!("verne-glider-adaptive-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (preset, step) in [
+        ("orthoglide", "0.005"),
+        ("biglide1", "0.004"),
+        ("biglide2", "0.004"),
+    ] {
+        let mut summaries = Vec::new();
+        let mut files = Vec::new();
+        for how in ["--uniform", "--adaptive"] {
+            let csv = dir.join(format!("{preset}{how}.csv"));
+            let out = run(
+                &[
+                    "workspace",
+                    "-m",
+                    preset,
+                    "--step",
+                    step,
+                    how,
+                    "-o",
+                    csv.to_str().unwrap(),
+                ],
+                None,
+            );
+            assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+            summaries.push(stderr(&out).replace(csv.to_str().unwrap(), "OUT"));
+            files.push(std::fs::read(&csv).unwrap());
+        }
+        assert_eq!(files[0], files[1], "{preset}: the points CSV");
+        let count = |text: &str| -> u64 {
+            let line = text.lines().find(|l| l.starts_with("  grid:")).unwrap();
+            let before = line.strip_suffix(" points classified").unwrap();
+            before.rsplit(' ').next().unwrap().parse().unwrap()
+        };
+        assert!(
+            count(&summaries[1]) * 3 < count(&summaries[0]),
+            "{preset}: {} and {} classified",
+            count(&summaries[0]),
+            count(&summaries[1])
+        );
+        let without_grid = |text: &str| -> Vec<String> {
+            text.lines()
+                .filter(|l| !l.starts_with("  grid:"))
+                .map(str::to_string)
+                .collect()
+        };
+        assert_eq!(
+            without_grid(&summaries[0]),
+            without_grid(&summaries[1]),
+            "{preset}"
+        );
+    }
+    let out = run(&["workspace", "-m", "orthoglide"], None);
+    assert_eq!(out.status.code(), Some(0));
+    assert!(stderr(&out).contains("801 x 801 nodes, step 0.002079, adaptive from a coarse step"));
+    for refused in [
+        &["--of", "tool"][..],
+        &["--tool-length", "10"],
+        &["--bounds", "0,1,0,1,0,1"],
+        &["--inside-only", "-o", "-"],
+        &["--slice", "z=1", "--plot", "x.svg"],
+        &["--sweep", "tool.length=0..10:2"],
+    ] {
+        let mut args = vec!["workspace", "-m", "biglide1"];
+        args.extend_from_slice(refused);
+        let out = run(&args, None);
+        assert_eq!(out.status.code(), Some(2), "{refused:?}");
+        assert!(
+            stderr(&out).contains(&format!(
+                "{} applies to the VERNE machine's workspace",
+                refused[0]
+            )),
+            "{refused:?}: {}",
+            stderr(&out)
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

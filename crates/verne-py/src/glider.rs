@@ -280,16 +280,27 @@ fn rectangle_dict<'py>(py: Python<'py>, r: Option<Rectangle>) -> PyResult<PyObje
 /// assembly mode `assembly` (sign "+" or "-"), with both amplification factors within
 /// `lambda_bounds` (None: the paper's 1/3 .. 3; `False`: no bound), as `verne workspace -m
 /// GLIDER`; the largest rectangle and square with their sides at each of `shape_angles` (rad;
-/// default 0 and pi/4, as the CLI), the larger kept. Returns a dict: `step`, `origin`, `class[ny, nx]` (int8, index into
-/// `verne.GLIDER_NODE_CLASSES`), `region[ny, nx]` (bool), `x[ny, nx]`, `y[ny, nx]` (node
-/// positions), `admissible_area`, `region_area`, `largest_square` and `largest_rectangle`
-/// (dicts with centre, width, height, angle, area, corners; None when the region is empty).
+/// default 0 and pi/4, as the CLI), the larger kept. `sampling`: "auto" (adaptive from 513
+/// nodes), "uniform" (every node classified) or "adaptive" (a coarse grid refined where the
+/// class or the binding constraint changes: the same grid wherever no feature hides inside a
+/// coarse cell, at a cost that grows with the boundary). Returns a dict: `step`, `origin`,
+/// `class[ny, nx]` (int8, index into `verne.GLIDER_NODE_CLASSES`), `region[ny, nx]` (bool),
+/// `x[ny, nx]`, `y[ny, nx]` (node positions), `admissible_area`, `region_area`,
+/// `region_area_bounds` (the cells all in the region, and those touching it),
+/// `region_area_sampled` and `region_area_half_width` (one pseudo-random point a boundary
+/// cell, 99.7 % Hoeffding), `classified` (points classified), `coarse_step` (None when
+/// uniform), `largest_square` and `largest_rectangle` (dicts with centre, width, height,
+/// angle, area, corners; None when the region is empty).
 ///
 /// >>> w = verne.glider_workspace(verne.Glider.preset("orthoglide"), nodes=201)
 /// >>> round(w["region_area"], 2), w["class"].shape == w["region"].shape
 /// (1.23, True)
+/// >>> lo, hi = w["region_area_bounds"]
+/// >>> bool(lo <= w["region_area_sampled"] <= hi), w["coarse_step"] is None
+/// (True, True)
 #[pyfunction]
-#[pyo3(signature = (glider, nodes=801, mode="++", assembly="+", lambda_bounds=None, shape_angles=None))]
+#[pyo3(signature = (glider, nodes=801, mode="++", assembly="+", lambda_bounds=None, shape_angles=None, sampling="auto"))]
+#[allow(clippy::too_many_arguments)]
 fn glider_workspace<'py>(
     py: Python<'py>,
     glider: &PyGlider,
@@ -298,7 +309,18 @@ fn glider_workspace<'py>(
     assembly: &str,
     lambda_bounds: Option<&Bound<'py, PyAny>>,
     shape_angles: Option<Vec<f64>>,
+    sampling: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let sampling = match sampling {
+        "auto" => glider::Sampling::Auto,
+        "uniform" => glider::Sampling::Uniform,
+        "adaptive" => glider::Sampling::Adaptive,
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "sampling={other:?}: expected \"auto\", \"uniform\" or \"adaptive\""
+            )));
+        }
+    };
     let mode = WorkingMode::parse(mode)
         .filter(|m| m.strut1 != Branch::Double && m.strut2 != Branch::Double)
         .ok_or_else(|| {
@@ -347,6 +369,7 @@ fn glider_workspace<'py>(
         nodes,
         frame_angle: 0.0,
         seed: None,
+        sampling,
     };
     let spec = &glider.inner;
     let (grid, square, rectangle) = py.allow_threads(|| {
@@ -395,6 +418,12 @@ fn glider_workspace<'py>(
     d.set_item("y", y.into_pyarray(py))?;
     d.set_item("admissible_area", grid.admissible_area())?;
     d.set_item("region_area", grid.region_area())?;
+    let e = grid.region_estimate;
+    d.set_item("region_area_bounds", (e.lo, e.hi))?;
+    d.set_item("region_area_sampled", e.sampled)?;
+    d.set_item("region_area_half_width", e.half_width)?;
+    d.set_item("classified", grid.classified)?;
+    d.set_item("coarse_step", grid.coarse_step)?;
     d.set_item("largest_square", rectangle_dict(py, square)?)?;
     d.set_item("largest_rectangle", rectangle_dict(py, rectangle)?)?;
     Ok(d)

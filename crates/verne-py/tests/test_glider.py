@@ -76,6 +76,28 @@ def test_glider_workspace_is_the_cli():
         verne.glider_workspace(g, mode="+0")
     with pytest.raises(ValueError, match="nodes"):
         verne.glider_workspace(g, nodes=1)
+    with pytest.raises(ValueError, match="sampling"):
+        verne.glider_workspace(g, sampling="sparse")
+
+
+def test_glider_workspace_adaptive_is_the_uniform_grid():
+    for name in ("biglide1", "biglide2", "orthoglide"):
+        g = verne.Glider.preset(name)
+        u = verne.glider_workspace(g, nodes=601, sampling="uniform")
+        a = verne.glider_workspace(g, nodes=601, sampling="adaptive")
+        assert (u["class"] == a["class"]).all() and (u["region"] == a["region"]).all()
+        assert u["largest_rectangle"] == a["largest_rectangle"]
+        assert u["region_area_sampled"] == a["region_area_sampled"]
+        assert u["coarse_step"] is None and a["coarse_step"] == pytest.approx(8 * a["step"])
+        assert a["classified"] * 3 < u["classified"]
+        lo, hi = a["region_area_bounds"]
+        assert lo <= a["region_area"] <= hi
+        assert abs(a["region_area_sampled"] - a["region_area"]) <= hi - lo
+    # The default grid (801 nodes) is adaptive, and reports the CLI's count of points.
+    w = verne.glider_workspace(verne.Glider.preset("orthoglide"))
+    _, text = run("workspace", "-m", "orthoglide")
+    classified = int(re.search(r"(\d+) points classified", text).group(1))
+    assert w["coarse_step"] is not None and w["classified"] == classified
 
 
 def test_glider_bad_rows():

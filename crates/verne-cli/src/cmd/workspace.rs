@@ -17,8 +17,10 @@ use verne::workspace::{
     self, Bounds, Constraint, Of, Outcome, PAPER_LAMBDA_BOUNDS, WorkspaceOptions, WorkspaceSummary,
 };
 
+use super::glider::workspace::GridSize;
 use super::{EXIT_OK, EXIT_ROWS_FAILED, load_machine, units, write_stdout};
 use crate::cli::{WorkspaceArgs, WorkspaceOf};
+use verne::glider::Sampling;
 
 /// Grid step of the VERNE workspace when `--step` is not given (mm).
 const DEFAULT_STEP_MM: f64 = 10.0;
@@ -315,11 +317,34 @@ fn run_adaptive(
 
 pub fn run(args: &WorkspaceArgs) -> Result<u8, VerneError> {
     if let Some(spec) = super::glider::load(args.common.machine.as_deref())? {
+        // The options of the VERNE machine's workspace have no meaning for a planar glider:
+        // refused, not ignored.
+        let not_for_a_glider = [
+            ("--of", args.of.is_some()),
+            ("--tool-length", !args.tool_length.is_empty()),
+            ("--bounds", args.bounds.is_some()),
+            ("--inside-only", args.inside_only),
+            ("--slice", !args.slice.is_empty()),
+            ("--sweep", !args.sweep.is_empty()),
+        ];
+        if let Some((flag, _)) = not_for_a_glider.iter().find(|(_, given)| *given) {
+            return Err(VerneError::Usage(format!(
+                "{flag} applies to the VERNE machine's workspace, not to a glider's (`{}`): \
+                 a glider's takes --step, --lambda, --adaptive or --uniform, -o and --plot \
+                 (docs/gliders.md)",
+                spec.name
+            )));
+        }
+        let sampling = match (args.adaptive, args.uniform) {
+            (true, _) => Sampling::Adaptive,
+            (_, true) => Sampling::Uniform,
+            _ => Sampling::Auto,
+        };
         return super::glider::workspace(
             &spec,
-            args.step,
-            None,
+            args.step.map_or(GridSize::Default, GridSize::Step),
             Some(args.lambda.unwrap_or(PAPER_LAMBDA_BOUNDS)),
+            sampling,
             args.output.as_deref(),
             args.plot.as_deref(),
             units(&args.common),

@@ -160,6 +160,7 @@ def glider_workspace(
     assembly: Literal["+", "-"] = "+",
     lambda_bounds: Union[None, bool, Tuple[float, float]] = None,
     shape_angles: Optional[List[float]] = None,
+    sampling: Literal["auto", "uniform", "adaptive"] = "auto",
 ) -> Dict[str, Any]: ...
 def design_tables(
     lambda_bounds: Optional[Tuple[float, float]] = None,

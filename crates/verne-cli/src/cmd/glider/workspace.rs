@@ -6,8 +6,9 @@ use std::path::Path;
 
 use csv::ByteRecord;
 use verne::glider::{
-    GliderSpec, NodeClass, Rectangle, WorkspaceGrid, WorkspaceOptions, amplification, branch_label,
-    inverse_kinematics_in_mode, largest_rectangle, largest_square, mode_label, sample_workspace,
+    GliderSpec, NodeClass, Rectangle, Sampling, WorkspaceGrid, WorkspaceOptions, amplification,
+    branch_label, inverse_kinematics_in_mode, largest_rectangle, largest_square, mode_label,
+    sample_workspace,
 };
 
 use crate::cmd::{EXIT_OK, EXIT_ROWS_FAILED};
@@ -21,6 +22,17 @@ pub const WORKSPACE_DEFAULT_NODES: usize = 801;
 
 /// Most grid nodes along one side of a workspace (memory: 2 bytes per node).
 pub const WORKSPACE_MAX_NODES: usize = 10_001;
+
+/// How fine the grid is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum GridSize {
+    /// [`WORKSPACE_DEFAULT_NODES`] along the window's longer side.
+    Default,
+    /// A step in the spec's length unit.
+    Step(f64),
+    /// Nodes along the window's longer side.
+    Nodes(usize),
+}
 
 /// Header of the workspace points CSV.
 pub const WORKSPACE_HEADER: [&str; 8] = [
@@ -45,10 +57,12 @@ fn class_code(c: NodeClass) -> &'static str {
 /// centre of the joint box; S is the largest rectangle in it, sides at 0 or 45 deg
 /// (docs/gliders.md).
 ///
-/// - `step`: grid step in the spec's length unit; `nodes`: grid nodes along the longer side of
-///   the window (default [`WORKSPACE_DEFAULT_NODES`]); give at most one.
+/// - `size`: the grid's step in the spec's length unit, or its nodes along the longer side of
+///   the window (at most [`WORKSPACE_MAX_NODES`]).
 /// - `lambda_bounds`: eq. (4) bounds on both amplification factors (`Some(PAPER_LAMBDA_BOUNDS)`
 ///   for the paper's 1/3 < lambda < 3), `None` for none.
+/// - `sampling`: every node classified, or only those near the boundaries between classes
+///   (the same grid wherever no feature hides inside a coarse cell; [`Sampling`]).
 /// - `output`: the points CSV ([`WORKSPACE_HEADER`], one row per node, y slowest), written
 ///   atomically; `None` writes no points, `-` writes stdout.
 /// - `plot`: a picture (SVG or PNG) of the workspace, the region, the rectangle and the guides.
@@ -56,9 +70,9 @@ fn class_code(c: NodeClass) -> &'static str {
 /// The summary goes to stderr. Returns exit code 0, or 1 when the region is empty.
 pub fn workspace(
     spec: &GliderSpec,
-    step: Option<f64>,
-    nodes: Option<usize>,
+    size: GridSize,
     lambda_bounds: Option<[f64; 2]>,
+    sampling: Sampling,
     output: Option<&Path>,
     plot: Option<&Path>,
     units: Units,
@@ -75,15 +89,11 @@ pub fn workspace(
     }
     let base = WorkspaceOptions {
         lambda_bounds,
+        sampling,
         ..WorkspaceOptions::default()
     };
-    let nodes = match (step, nodes) {
-        (Some(_), Some(_)) => {
-            return Err(VerneError::Usage(
-                "give the grid as a step or as a node count, not both".into(),
-            ));
-        }
-        (Some(s), None) => {
+    let nodes = match size {
+        GridSize::Step(s) => {
             if !(s.is_finite() && s > 0.0) {
                 return Err(VerneError::Usage(format!(
                     "step {s}: expected a length > 0"
@@ -107,7 +117,7 @@ pub fn workspace(
             }
             n.max(2.0) as usize
         }
-        (None, Some(n)) => {
+        GridSize::Nodes(n) => {
             if !(2..=WORKSPACE_MAX_NODES).contains(&n) {
                 return Err(VerneError::Usage(format!(
                     "{n} nodes: expected 2 to {WORKSPACE_MAX_NODES}"
@@ -115,7 +125,7 @@ pub fn workspace(
             }
             n
         }
-        (None, None) => WORKSPACE_DEFAULT_NODES,
+        GridSize::Default => WORKSPACE_DEFAULT_NODES,
     };
     let opts = WorkspaceOptions { nodes, ..base };
     let grid = sample_workspace(spec, &opts);
@@ -159,11 +169,19 @@ pub fn workspace(
         mode_label(opts.mode),
         branch_label(opts.assembly)
     );
-    let _ = writeln!(
-        s,
-        "  grid: {} x {} nodes, step {:.6}",
-        grid.nx, grid.ny, grid.step
-    );
+    let _ = match grid.coarse_step {
+        Some(coarse) => writeln!(
+            s,
+            "  grid: {} x {} nodes, step {:.6}, adaptive from a coarse step of {coarse:.6}: {} \
+             points classified",
+            grid.nx, grid.ny, grid.step, grid.classified
+        ),
+        None => writeln!(
+            s,
+            "  grid: {} x {} nodes, step {:.6}, uniform: {} points classified",
+            grid.nx, grid.ny, grid.step, grid.classified
+        ),
+    };
     let _ = writeln!(
         s,
         "  workspace of mode {} within the joint ranges: area {:.6} ({reached} nodes)",
@@ -179,12 +197,18 @@ pub fn workspace(
     match grid.seed {
         Some((i, j)) => {
             let c = grid.node(i, j);
+            let e = grid.region_estimate;
             let _ = writeln!(
                 s,
-                "  t-connected region of ({:.6}, {:.6}): area {:.6}",
+                "  t-connected region of ({:.6}, {:.6}): area {:.6} (between {:.6} and {:.6}; \
+                 sampled {:.6} +- {:.6} at 99.7 %)",
                 c.x,
                 c.y,
-                grid.region_area()
+                grid.region_area(),
+                e.lo,
+                e.hi,
+                e.sampled,
+                e.half_width
             );
         }
         None => {
@@ -291,9 +315,9 @@ mod tests {
         let spec = GliderSpec::preset("orthoglide").unwrap();
         let code = workspace(
             &spec,
-            None,
-            Some(101),
+            GridSize::Nodes(101),
             Some(PAPER_LAMBDA_BOUNDS),
+            Sampling::Auto,
             Some(&csv),
             Some(&svg),
             Units::default(),
@@ -331,25 +355,41 @@ mod tests {
     #[test]
     fn workspace_step_sets_the_grid_and_bad_arguments_are_refused() {
         let spec = GliderSpec::preset("biglide2").unwrap();
-        let ok = workspace(&spec, Some(0.05), None, None, None, None, Units::default());
-        assert_eq!(ok.unwrap(), EXIT_OK);
-        let both = workspace(
+        let ok = workspace(
             &spec,
-            Some(0.05),
-            Some(11),
+            GridSize::Step(0.05),
             None,
+            Sampling::Auto,
             None,
             None,
             Units::default(),
         );
-        assert!(both.unwrap_err().to_string().contains("not both"));
-        let tiny = workspace(&spec, Some(1e-9), None, None, None, None, Units::default());
+        assert_eq!(ok.unwrap(), EXIT_OK);
+        let few = workspace(
+            &spec,
+            GridSize::Nodes(1),
+            None,
+            Sampling::Auto,
+            None,
+            None,
+            Units::default(),
+        );
+        assert!(few.unwrap_err().to_string().contains("expected 2 to"));
+        let tiny = workspace(
+            &spec,
+            GridSize::Step(1e-9),
+            None,
+            Sampling::Auto,
+            None,
+            None,
+            Units::default(),
+        );
         assert!(tiny.unwrap_err().to_string().contains("larger step"));
         let gif = workspace(
             &spec,
+            GridSize::Nodes(11),
             None,
-            Some(11),
-            None,
+            Sampling::Auto,
             None,
             Some(Path::new("w.gif")),
             Units::default(),
@@ -357,9 +397,9 @@ mod tests {
         assert!(gif.unwrap_err().to_string().contains(".svg or .png"));
         let bounds = workspace(
             &spec,
-            None,
-            Some(11),
+            GridSize::Nodes(11),
             Some([3.0, 1.0]),
+            Sampling::Auto,
             None,
             None,
             Units::default(),
