@@ -49,8 +49,9 @@ fn counts<'py>(
 /// cells `volume_sampled_mm3` +- `sampled_half_width_mm3` (99.7 % confidence). Uniform sampling gives every point: `points=True` adds
 /// `grid_points[N, 3]` (mm) and `outcome[N]` (int8, index into `verne.OUTCOMES`, x fastest).
 /// Returns a dict: the volume, its error, the bounding box, the largest box and cube (adaptive:
-/// found on the fine lattice, with `upper_bound_mm3`, a volume none of it exceeds), the points
-/// per outcome and per failed constraint.
+/// found on the fine lattice, with `upper_bound_mm3`, a volume none of it exceeds; `box_exact`
+/// when the box of the inside points was small enough to search exhaustively, the bound then
+/// the volume), the points per outcome and per failed constraint.
 ///
 /// >>> w = verne.workspace(m, step=40)
 /// >>> w["method"], w["inside"], round(w["volume_litres"], 1)
@@ -164,6 +165,7 @@ fn workspace<'py>(
                 .transpose()?;
             d.set_item(key, item)?;
         }
+        d.set_item("box_exact", a.box_exact)?;
         d.set_item("touches_bounds", a.touches_bounds)?;
         d.set_item(
             "binding",

@@ -92,15 +92,17 @@ def test_workspace_is_verne_workspace():
     assert a["volume_lo_mm3"] <= u["volume_mm3"] <= a["volume_hi_mm3"]
     assert a["inside"] == u["inside"]
     assert str(a["classified"]) in text.replace(",", "")
-    # The largest box: no larger than the uniform grid's exhaustive one, which is within the bound.
-    best = u["largest_box"]["volume_mm3"]
-    assert a["largest_box"]["volume_mm3"] <= best <= a["largest_box"]["upper_bound_mm3"]
+    # The largest box: at 20 mm searched exhaustively, the uniform grid's, its bound itself.
+    assert a["box_exact"]
+    for key in ("largest_box", "largest_cube"):
+        assert a[key]["volume_mm3"] == pytest.approx(u[key]["volume_mm3"], rel=1e-12)
+        assert a[key]["min"] == pytest.approx(u[key]["min"]) and a[key]["max"] == pytest.approx(u[key]["max"])
+        assert a[key]["upper_bound_mm3"] == a[key]["volume_mm3"]
     cube = u["largest_cube"]["volume_mm3"]
-    assert a["largest_cube"]["volume_mm3"] <= cube <= a["largest_cube"]["upper_bound_mm3"]
     edges = [hi - lo for lo, hi in zip(u["largest_cube"]["min"], u["largest_cube"]["max"])]
     assert max(edges) - min(edges) < 1e-9 and cube == pytest.approx(edges[0] ** 3)
     assert math.isclose(
-        a["largest_box"]["volume_mm3"] * 1e-6, summary_number(text, r"mm = ([\d.]+) l \(no box"), abs_tol=1e-3
+        a["largest_box"]["volume_mm3"] * 1e-6, summary_number(text, r"largest box .* mm = ([\d.]+) l"), abs_tol=1e-3
     )
     # The boundary sample: the CLI's estimate, inside the bracket.
     assert a["volume_lo_mm3"] <= a["volume_sampled_mm3"] <= a["volume_hi_mm3"]

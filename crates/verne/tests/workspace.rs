@@ -267,7 +267,29 @@ fn compare(m: &Machine, opts: &WorkspaceOptions, factor: usize) -> (u64, u64) {
         .unwrap()
         .unwrap();
     let (uniform, uniform_map) = (run.summary, run.map);
-    let adaptive = workspace::compute_adaptive(m, opts, factor, &|_| {}).unwrap();
+    // The largest box and cube grown from the coarse lattice's (as on fine lattices), and
+    // searched exhaustively (as on these small ones).
+    let adaptive = workspace::compute_adaptive_with(m, opts, factor, 0, &|_| {}).unwrap();
+    let exact = workspace::compute_adaptive(m, opts, factor, &|_| {}).unwrap();
+    assert!(!adaptive.box_exact && exact.box_exact);
+    assert_eq!(adaptive.box_lattice_step, opts.step * factor as f64);
+    // And from the lattice of every (factor / 2)-th point of the inside points' box too: a
+    // limit that admits it (twice the limit) and not the fine lattice.
+    let bb = adaptive.bbox.unwrap();
+    let half = factor / 2;
+    let limit: u64 = [0, 1, 2]
+        .map(|d| ((bb.max[d] - bb.min[d]) / opts.step).round() as usize)
+        .iter()
+        .map(|&e| e.div_ceil(half) as u64 + 1)
+        .product::<u64>()
+        .div_ceil(2);
+    let middle = workspace::compute_adaptive_with(m, opts, factor, limit, &|_| {}).unwrap();
+    assert!(!middle.box_exact);
+    assert_eq!(middle.box_lattice_step, opts.step * half as f64);
+    assert!(middle.largest_box_mm3 >= adaptive.largest_box_mm3);
+    assert!(middle.largest_box_upper_mm3 <= adaptive.largest_box_upper_mm3);
+    assert!(middle.largest_cube_mm3 >= adaptive.largest_cube_mm3);
+    assert!(middle.largest_cube_upper_mm3 <= adaptive.largest_cube_upper_mm3);
     let name = format!(
         "{} {} mm, tool {} mm",
         opts.of.name(),
@@ -338,6 +360,35 @@ fn compare(m: &Machine, opts: &WorkspaceOptions, factor: usize) -> (u64, u64) {
         "{name}: found {} <= uniform {best} <= bound {}",
         adaptive.largest_box_mm3,
         adaptive.largest_box_upper_mm3
+    );
+    all_inside(&middle.largest_box.unwrap(), "box (middle lattice)");
+    all_inside(&middle.largest_cube.unwrap(), "cube (middle lattice)");
+    assert!(
+        middle.largest_box_mm3 <= best * (1.0 + 1e-12)
+            && best <= middle.largest_box_upper_mm3 * (1.0 + 1e-12)
+            && middle.largest_cube_mm3 <= best_cube * (1.0 + 1e-12)
+            && best_cube <= middle.largest_cube_upper_mm3 * (1.0 + 1e-12),
+        "{name}: middle lattice {middle:?}"
+    );
+    // The exhaustive search finds the uniform grid's box and cube, with the bounds equal.
+    let (uniform_box, _) = uniform.largest_box_size().unwrap();
+    let (uniform_cube, _) = uniform.largest_cube_size().unwrap();
+    let close = |a: Bounds, b: Bounds| (a.min - b.min).norm() + (a.max - b.max).norm() < 1e-9;
+    assert!(
+        close(exact.largest_box.unwrap(), uniform_box),
+        "{name}: exact box"
+    );
+    assert!(
+        close(exact.largest_cube.unwrap(), uniform_cube),
+        "{name}: exact cube"
+    );
+    assert!((exact.largest_box_mm3 - best).abs() <= 1e-9 * best);
+    assert!((exact.largest_cube_mm3 - best_cube).abs() <= 1e-9 * best_cube);
+    assert_eq!(exact.largest_box_upper_mm3, exact.largest_box_mm3);
+    assert_eq!(exact.largest_cube_upper_mm3, exact.largest_cube_mm3);
+    assert_eq!(
+        (exact.inside_points, exact.classified),
+        (adaptive.inside_points, adaptive.classified)
     );
     let (ub, ab) = (uniform.bbox.unwrap(), adaptive.bbox.unwrap());
     assert!(

@@ -300,7 +300,10 @@ fn run_adaptive(
                     ""
                 }
             );
-            let found = |b: Option<Bounds>, v: f64, upper: f64| b.map(|b| (b, v, Some(upper)));
+            // An exhaustive search (small lattices) is exact, as the uniform grid's: no bound.
+            let found = |b: Option<Bounds>, v: f64, upper: f64| {
+                b.map(|b| (b, v, (!a.box_exact).then_some(upper)))
+            };
             largest_box_lines(
                 &mut text,
                 found(a.largest_box, a.largest_box_mm3, a.largest_box_upper_mm3),

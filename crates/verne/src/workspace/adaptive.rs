@@ -31,7 +31,7 @@ use crate::spec::Machine;
 
 use super::GridBox;
 use super::grid::{Bounds, default_bounds, round_bounds};
-use super::refined_box::refined_largest_box;
+use super::refined_box::{SubLattice, exact_largest_box, refined_largest_box};
 use super::{WorkspaceOptions, classify};
 
 /// The coarse step is the requested step times this, by default (a power of two).
@@ -42,6 +42,14 @@ pub const BOUNDARY_SAMPLES: u64 = 200_000;
 
 /// The confidence of the sampled estimate's half-width: 1 - delta = 99.7 %.
 pub const SAMPLED_CONFIDENCE_DELTA: f64 = 0.003;
+
+/// Up to this many fine lattice points in the box of the inside points, the largest box and
+/// cube are searched exhaustively on the fine lattice (exact, as on the uniform grid); above,
+/// grown from those of the coarse lattice and of a lattice of every fourth point (coarse
+/// factor 8) if it has at most twice this many, with bounds (`refined_box.rs`). On the default
+/// machine's platform workspace: exact down to a 5 mm step (7 million points, 1 s), every
+/// fourth point at 4, 2 and 1 mm (13.6 million at 1 mm, about 4 s).
+pub const EXACT_BOX_POINTS: u64 = 8_000_000;
 
 /// What an adaptive run found.
 #[derive(Debug, Clone, PartialEq)]
@@ -87,9 +95,16 @@ pub struct AdaptiveSummary {
     pub largest_cube: Option<Bounds>,
     pub largest_cube_mm3: f64,
     pub largest_cube_upper_mm3: f64,
-    /// Fine points examined to grow the largest box and cube (in a leaf cell all inside, or
-    /// classified; not in `classified`).
+    /// Fine points examined to grow the largest box and cube, or to search them exhaustively
+    /// (in a leaf cell whose corners agree, or classified; not in `classified`).
     pub box_points_examined: u64,
+    /// Whether the largest box and cube were searched exhaustively on the fine lattice (their
+    /// bounds are then their volumes).
+    pub box_exact: bool,
+    /// The step (mm) of the finest lattice whose largest box and cube were grown, and that the
+    /// bounds come from (the coarse lattice's too, the better kept): half the coarse step or
+    /// the coarse step; the step itself when exact.
+    pub box_lattice_step: f64,
     /// An inside point on the lattice's outer layer: the bounds may cut the workspace.
     pub touches_bounds: bool,
 }
@@ -107,6 +122,19 @@ pub fn compute_adaptive(
     m: &Machine,
     opts: &WorkspaceOptions,
     coarse_factor: usize,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<AdaptiveSummary, String> {
+    compute_adaptive_with(m, opts, coarse_factor, EXACT_BOX_POINTS, progress)
+}
+
+/// [`compute_adaptive`] with the largest box and cube searched exhaustively on the fine lattice
+/// up to `exact_box_points` points in the inside points' box, grown from every (coarse factor /
+/// 2)-th point of it up to twice as many (0: always grown from the coarse lattice's).
+pub fn compute_adaptive_with(
+    m: &Machine,
+    opts: &WorkspaceOptions,
+    coarse_factor: usize,
+    exact_box_points: u64,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<AdaptiveSummary, String> {
     if !(coarse_factor >= 2 && coarse_factor.is_power_of_two()) {
@@ -175,6 +203,8 @@ pub fn compute_adaptive(
         largest_cube_mm3: 0.0,
         largest_cube_upper_mm3: 0.0,
         box_points_examined: 0,
+        box_exact: false,
+        box_lattice_step: step,
         touches_bounds: false,
     };
     // A place in lattice units (a lattice point has whole coordinates).
@@ -219,16 +249,59 @@ pub fn compute_adaptive(
         });
         summary.touches_bounds = (0..3).any(|d| lo[d] == 0 || hi[d] == n[d] - 1);
         let coarse_n = n.map(|v| (v - 1) / s0 + 1);
-        // A point in a leaf cell all inside is inside (the volume's assumption); others are
-        // classified.
-        let inside_at = |p: [usize; 3]| {
-            refined.inside_leaves.iter().any(|(size, keys)| {
+        // A point in a leaf cell whose corners agree has their outcome (the volume's
+        // assumption); others are classified.
+        let in_leaf = |leaves: &[(usize, Vec<u64>)], p: [usize; 3]| {
+            leaves.iter().any(|(size, keys)| {
                 let cell = p.map(|v| v / size * size);
                 keys.binary_search(&lattice.key::<u64>(cell)).is_ok()
-            }) || classify_point(p.map(|v| v as f64)) == INSIDE
+            })
+        };
+        let inside_at = |p: [usize; 3]| {
+            in_leaf(&refined.inside_leaves, p)
+                || !in_leaf(&refined.outside_leaves, p)
+                    && classify_point(p.map(|v| v as f64)) == INSIDE
         };
         let bbox = GridBox { lo, hi };
-        let r = refined_largest_box(coarse_n, &refined.coarse_inside, s0, bbox, &inside_at);
+        // Every fine point of the box searched exhaustively when they are at most
+        // `exact_box_points`; else the box and cube grown from the coarse lattice's and, when
+        // it has at most twice as many points, from those of the lattice of every (s0 / 2)-th
+        // fine point of the box (whose points lie mostly in the leaf cells of the two coarsest
+        // levels, known without classifying them).
+        let sub_points = |m: usize| -> u64 {
+            bbox.edges()
+                .iter()
+                .map(|&e| e.div_ceil(m) as u64 + 1)
+                .product()
+        };
+        let m = if sub_points(1) <= exact_box_points {
+            1
+        } else if s0 >= 4 && sub_points(s0 / 2) <= 2 * exact_box_points {
+            s0 / 2
+        } else {
+            s0
+        };
+        summary.box_exact = m == 1;
+        let r = if summary.box_exact {
+            exact_largest_box(bbox, &inside_at)
+        } else {
+            let coarse = SubLattice {
+                origin: [0; 3],
+                step: s0,
+                n: coarse_n,
+                inside: refined.coarse_inside.clone(),
+            };
+            let mut r = refined_largest_box(&coarse, n, bbox, &inside_at);
+            summary.box_lattice_step = step * s0 as f64;
+            if m < s0 {
+                // Both results hold: the larger boxes, the smaller bounds.
+                let sub = SubLattice::of_box(bbox, m, &inside_at);
+                r = r.better(refined_largest_box(&sub, n, bbox, &inside_at));
+                r.examined += sub.len();
+                summary.box_lattice_step = step * m as f64;
+            }
+            r
+        };
         // (corners in mm, volume in mm^3) of a box of fine indices and steps^3.
         let in_mm = |found: Option<(GridBox, f64)>| {
             found.map_or((None, 0.0), |(g, v)| {
@@ -258,6 +331,7 @@ fn refine<K: Key>(
     let n = lattice.n;
     let mut coarse_inside = Vec::new();
     let mut inside_leaves = Vec::new();
+    let mut outside_leaves = Vec::new();
     let mut tally = Tally::empty();
     let mut classified = 0u64;
     // The cells of this level by their first corner's key, sorted; at first every coarse cell.
@@ -292,14 +366,20 @@ fn refine<K: Key>(
         let (level, parents) = decide_level(lattice, &cells, s, &known);
         tally = tally.merge(&level);
         if s >= s0 / 2 && s >= 2 {
-            // The leaf cells all inside of the two coarsest levels (most of the interior), for
-            // the largest box: a point in one is inside without being classified.
-            let leaves: Vec<u64> = cells
-                .par_iter()
-                .filter(|&&c| parents.binary_search(&c).is_err() && known.at(c) == INSIDE)
-                .map(|&c| c.index() as u64)
-                .collect();
-            inside_leaves.push((s, leaves));
+            // The leaf cells of the two coarsest levels (most of the interior and of the
+            // outside), for the largest box: a point in one has its corners' outcome without
+            // being classified.
+            let leaves = |inside: bool| -> Vec<u64> {
+                cells
+                    .par_iter()
+                    .filter(|&&c| {
+                        parents.binary_search(&c).is_err() && (known.at(c) == INSIDE) == inside
+                    })
+                    .map(|&c| c.index() as u64)
+                    .collect()
+            };
+            inside_leaves.push((s, leaves(true)));
+            outside_leaves.push((s, leaves(false)));
         }
         drop(cells);
         if s == 2 {
@@ -345,6 +425,7 @@ fn refine<K: Key>(
         classified,
         coarse_inside,
         inside_leaves,
+        outside_leaves,
     }
 }
 
@@ -357,8 +438,9 @@ struct Refined {
     /// Which points of the coarse lattice (every `s0`-th fine point, x fastest) are inside.
     coarse_inside: Vec<bool>,
     /// For the two coarsest levels, the cell size and the sorted keys (64-bit) of the leaf
-    /// cells whose corners are all inside.
+    /// cells whose corners are all inside, and of those whose corners are all outside.
     inside_leaves: Vec<(usize, Vec<u64>)>,
+    outside_leaves: Vec<(usize, Vec<u64>)>,
 }
 
 /// A lattice point's key: its index `i + n0 (j + n1 k)`, in 32 or 64 bits.
@@ -762,6 +844,7 @@ mod tests {
         assert_eq!(c32, c64);
         assert_eq!(r32.coarse_inside, r64.coarse_inside);
         assert_eq!(r32.inside_leaves, r64.inside_leaves);
+        assert_eq!(r32.outside_leaves, r64.outside_leaves);
         assert!(t32.inside_points > 0);
         assert_eq!(
             (

@@ -2,6 +2,10 @@
 //! box that does not decrease when an edge grows (its volume, the largest cube it holds; the
 //! same grown by a margin, which bound the boxes of a finer lattice, see `refined_box.rs`).
 
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use crate::par::*;
+
 use super::{GridBox, Outcome, OutcomeGrid};
 
 /// Largest axis-aligned box of grid points all inside, by volume (edges counted in steps,
@@ -78,8 +82,8 @@ impl BoxMeasure {
 /// the best rectangle of that 2D mask by the histogram-and-stack method (every maximal
 /// rectangle is visited, so any measure that does not decrease with width and height is
 /// maximised). O(nz^2 nx ny) at worst, pruned: once the measure's bound for the mask's count
-/// and the tallest box left cannot beat the best box, the inner loop stops. Sequential, first
-/// best kept: deterministic.
+/// and the tallest box left cannot beat the best box, the inner loop stops. The first layers k0
+/// in parallel, the first best kept: the same box whatever the threads.
 pub fn largest_box_by(
     inside: &dyn Fn(usize, usize, usize) -> bool,
     lo: [usize; 3],
@@ -102,65 +106,87 @@ pub fn largest_box_by(
     };
     let layers: Vec<Vec<bool>> = (lo[2]..=hi[2]).map(layer).collect();
     let nz = layers.len();
-    let mut best = 0.0f64;
-    let mut best_box = None;
-    let mut heights = vec![0usize; nx];
-    let mut stack: Vec<(usize, usize)> = Vec::with_capacity(nx + 1);
-    for k0 in 0..nz {
-        let mut mask = layers[k0].clone();
-        for (k1, layer) in layers.iter().enumerate().skip(k0) {
-            if k1 > k0 {
-                for (a, b) in mask.iter_mut().zip(layer) {
-                    *a &= *b;
-                }
-            }
-            let count = mask.iter().filter(|&&b| b).count() as u64;
-            if count == 0 || measure.bound(count, nx, ny, nz - 1 - k0) <= best {
-                break;
-            }
-            let dz = k1 - k0;
-            if measure.bound(count, nx, ny, dz) <= best {
-                continue;
-            }
-            // The best rectangle of the mask.
-            heights.iter_mut().for_each(|h| *h = 0);
-            let mut best2 = best;
-            let mut rect = None;
-            for j in 0..ny {
-                for (h, &m) in heights.iter_mut().zip(&mask[j * nx..(j + 1) * nx]) {
-                    *h = if m { *h + 1 } else { 0 };
-                }
-                stack.clear();
-                for i in 0..=nx {
-                    let h = heights.get(i).copied().unwrap_or(0);
-                    let mut start = i;
-                    while let Some(&(s, sh)) = stack.last() {
-                        if sh < h {
-                            break;
-                        }
-                        stack.pop();
-                        if sh >= 1 {
-                            let val = measure.of([i - s - 1, sh - 1, dz]);
-                            if val > best2 {
-                                best2 = val;
-                                rect = Some([s, i - 1, j + 1 - sh, j]);
-                            }
-                        }
-                        start = s;
+    // The best measure any k0 has found so far (the bits of a non-negative f64 order as the
+    // numbers do): a k0 stops where it cannot reach it. Strictly below it, so a k0 is never cut
+    // short of a box as large as the best: each k0's own best is the same whatever the
+    // threads, and the first k0 of the largest measure wins, as in a sequential search.
+    let shared = AtomicU64::new(0f64.to_bits());
+    let per_k0: Vec<(f64, Option<GridBox>)> = (0..nz)
+        .into_par_iter()
+        .map(|k0| {
+            let reached = || f64::from_bits(shared.load(Ordering::Relaxed));
+            let mut best = 0.0f64;
+            let mut best_box = None;
+            let mut heights = vec![0usize; nx];
+            let mut stack: Vec<(usize, usize)> = Vec::with_capacity(nx + 1);
+            let mut mask = layers[k0].clone();
+            for (k1, layer) in layers.iter().enumerate().skip(k0) {
+                if k1 > k0 {
+                    for (a, b) in mask.iter_mut().zip(layer) {
+                        *a &= *b;
                     }
-                    stack.push((start, h));
+                }
+                let count = mask.iter().filter(|&&b| b).count() as u64;
+                let tallest = measure.bound(count, nx, ny, nz - 1 - k0);
+                if count == 0 || tallest <= best || tallest < reached() {
+                    break;
+                }
+                let dz = k1 - k0;
+                let here = measure.bound(count, nx, ny, dz);
+                if here <= best || here < reached() {
+                    continue;
+                }
+                // The best rectangle of the mask.
+                heights.iter_mut().for_each(|h| *h = 0);
+                let mut best2 = best;
+                let mut rect = None;
+                for j in 0..ny {
+                    for (h, &m) in heights.iter_mut().zip(&mask[j * nx..(j + 1) * nx]) {
+                        *h = if m { *h + 1 } else { 0 };
+                    }
+                    stack.clear();
+                    for i in 0..=nx {
+                        let h = heights.get(i).copied().unwrap_or(0);
+                        let mut start = i;
+                        while let Some(&(s, sh)) = stack.last() {
+                            if sh < h {
+                                break;
+                            }
+                            stack.pop();
+                            if sh >= 1 {
+                                let val = measure.of([i - s - 1, sh - 1, dz]);
+                                if val > best2 {
+                                    best2 = val;
+                                    rect = Some([s, i - 1, j + 1 - sh, j]);
+                                }
+                            }
+                            start = s;
+                        }
+                        stack.push((start, h));
+                    }
+                }
+                if let Some(r) = rect {
+                    best = best2;
+                    shared.fetch_max(best.to_bits(), Ordering::Relaxed);
+                    best_box = Some(GridBox {
+                        lo: [lo[0] + r[0], lo[1] + r[2], lo[2] + k0],
+                        hi: [lo[0] + r[1], lo[1] + r[3], lo[2] + k1],
+                    });
                 }
             }
-            if let Some(r) = rect {
-                best = best2;
-                best_box = Some(GridBox {
-                    lo: [lo[0] + r[0], lo[1] + r[2], lo[2] + k0],
-                    hi: [lo[0] + r[1], lo[1] + r[3], lo[2] + k1],
-                });
-            }
+            (best, best_box)
+        })
+        .collect();
+    // The first k0 of the largest measure.
+    let mut best: Option<(GridBox, f64)> = None;
+    for (v, b) in per_k0 {
+        if let Some(b) = b
+            && best.is_none_or(|(_, bv)| v > bv)
+        {
+            best = Some((b, v));
         }
     }
-    best_box.map(|b| (b, best))
+    best
 }
 
 #[cfg(test)]
@@ -220,6 +246,52 @@ mod tests {
                     }
                 }
             }
+        }
+    }
+
+    /// Sets with many boxes of the largest measure (a full block with notches): the box kept
+    /// is the one the search meets first in (k0, k1, row, column) order, found by brute force
+    /// in that order, whatever the threads.
+    #[test]
+    fn ties_keep_the_first_box_whatever_the_threads() {
+        let n = [9, 8, 12];
+        let notched = |i: usize, j: usize, k: usize| !((i + 2 * j + 3 * k) % 7 == 0 && k % 4 == 1);
+        let hi = n.map(|v| v - 1);
+        for measure in [BoxMeasure::Volume, BoxMeasure::Cube] {
+            let run = |threads| {
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap()
+                    .install(|| largest_box_by(&notched, [0; 3], hi, measure))
+            };
+            let one = run(1);
+            for threads in [2, 3, 8] {
+                assert_eq!(run(threads), one, "{measure:?} with {threads} threads");
+            }
+            // The first in the search's order: lowest k0, then k1, then the rectangle's last
+            // row j1, then its column i1 + 1 (where the stack pops it), among the largest.
+            let (b, v) = one.unwrap();
+            let mut first: Option<([usize; 4], GridBox)> = None;
+            for lo in itertools3(n) {
+                for up in itertools3(n) {
+                    if (0..3).any(|d| up[d] < lo[d])
+                        || measure.of([0, 1, 2].map(|d| up[d] - lo[d])) != v
+                    {
+                        continue;
+                    }
+                    let all = (lo[2]..=up[2]).all(|k| {
+                        (lo[1]..=up[1]).all(|j| (lo[0]..=up[0]).all(|i| notched(i, j, k)))
+                    });
+                    let order = [lo[2], up[2], up[1], up[0]];
+                    if all && first.is_none_or(|(o, _)| order < o) {
+                        first = Some((order, GridBox { lo, hi: up }));
+                    }
+                }
+            }
+            let (_, expected) = first.unwrap();
+            assert_eq!(b.lo[2], expected.lo[2], "{measure:?}: the first k0");
+            assert_eq!(b.hi[2], expected.hi[2], "{measure:?}: the first k1");
         }
     }
 

@@ -44,8 +44,8 @@ use crate::parallel_module::equations::{ModulePose, Sliders};
 use crate::spec::Machine;
 
 pub use adaptive::{
-    AdaptiveSummary, BOUNDARY_SAMPLES, DEFAULT_COARSE_FACTOR, SAMPLED_CONFIDENCE_DELTA,
-    compute_adaptive,
+    AdaptiveSummary, BOUNDARY_SAMPLES, DEFAULT_COARSE_FACTOR, EXACT_BOX_POINTS,
+    SAMPLED_CONFIDENCE_DELTA, compute_adaptive, compute_adaptive_with,
 };
 pub use classify::{ALPHA_MATCH_RAD, classify, grid_point_of, manufacturing_tip, tool_tip};
 pub use grid::{Bounds, Grid, GridBox, MAX_GRID_POINTS, default_bounds, grid_for, round_bounds};

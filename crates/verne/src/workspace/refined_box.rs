@@ -40,16 +40,80 @@ pub(crate) struct RefinedBox {
     pub examined: u64,
 }
 
-/// The coarse lattice: `n` points along each axis, `inside` x fastest; the fine lattice has
-/// `s0 (n - 1) + 1` points along each axis. `bbox` is the fine index box of the inside points.
+impl RefinedBox {
+    /// The larger box and cube of two searches of the same lattice, and the smaller bounds
+    /// (both hold); the points examined added up.
+    pub fn better(self, o: RefinedBox) -> RefinedBox {
+        let larger = |a: Option<(GridBox, f64)>, b: Option<(GridBox, f64)>| match (a, b) {
+            (Some(x), Some(y)) => Some(if y.1 > x.1 { y } else { x }),
+            (x, y) => x.or(y),
+        };
+        RefinedBox {
+            found: larger(self.found, o.found),
+            upper: self.upper.min(o.upper),
+            cube: larger(self.cube, o.cube),
+            cube_upper: self.cube_upper.min(o.cube_upper),
+            examined: self.examined + o.examined,
+        }
+    }
+}
+
+/// A coarser lattice of the fine one: its point `c` is the fine point `origin + step c`; `n`
+/// points along each axis, `inside` x fastest.
+pub(crate) struct SubLattice {
+    pub origin: [usize; 3],
+    pub step: usize,
+    pub n: [usize; 3],
+    pub inside: Vec<bool>,
+}
+
+impl SubLattice {
+    /// Every `step`-th fine point of `bbox` (the fine index box of the inside points), and the
+    /// next one past its upper end (outside: no inside point lies beyond `bbox`), examined
+    /// with `inside_at`.
+    pub fn of_box(
+        bbox: GridBox,
+        step: usize,
+        inside_at: &(dyn Fn([usize; 3]) -> bool + Sync),
+    ) -> SubLattice {
+        let n = bbox.edges().map(|e| e.div_ceil(step) + 1);
+        let inside = (0..n[2])
+            .into_par_iter()
+            .flat_map_iter(|k| {
+                (0..n[1]).flat_map(move |j| {
+                    (0..n[0]).map(move |i| {
+                        let p = [i, j, k];
+                        let f = [0, 1, 2].map(|d| bbox.lo[d] + step * p[d]);
+                        (0..3).all(|d| f[d] <= bbox.hi[d]) && inside_at(f)
+                    })
+                })
+            })
+            .collect();
+        SubLattice {
+            origin: bbox.lo,
+            step,
+            n,
+            inside,
+        }
+    }
+
+    /// Its points, how many.
+    pub fn len(&self) -> u64 {
+        self.n.iter().map(|&v| v as u64).product()
+    }
+}
+
+/// The largest box and cube of the fine lattice (`fine_n` points along each axis) grown from
+/// those of the sub-lattice `sub`, with the bounds. `bbox` is the fine index box of the inside
+/// points.
 pub(crate) fn refined_largest_box(
-    coarse_n: [usize; 3],
-    coarse_inside: &[bool],
-    s0: usize,
+    sub: &SubLattice,
+    fine_n: [usize; 3],
     bbox: GridBox,
     inside_at: &(dyn Fn([usize; 3]) -> bool + Sync),
 ) -> RefinedBox {
-    let at = |i: usize, j: usize, k: usize| coarse_inside[i + coarse_n[0] * (j + coarse_n[1] * k)];
+    let (coarse_n, s0) = (sub.n, sub.step);
+    let at = |i: usize, j: usize, k: usize| sub.inside[i + coarse_n[0] * (j + coarse_n[1] * k)];
     let hi = coarse_n.map(|v| v - 1);
     let s = s0 as f64;
     // The bound first (it needs no fine point).
@@ -69,10 +133,11 @@ pub(crate) fn refined_largest_box(
         cube_upper: grown_cube.max((s - 2.0).max(0.0).powi(3)),
         examined: 0,
     };
-    let fine_n = coarse_n.map(|v| s0 * (v - 1) + 1);
+    // A box of the sub-lattice as fine indices, cut to the fine lattice (a sub-lattice point
+    // past it is outside, so no box found reaches one).
     let to_fine = |b: GridBox| GridBox {
-        lo: b.lo.map(|v| v * s0),
-        hi: b.hi.map(|v| v * s0),
+        lo: [0, 1, 2].map(|d| (sub.origin[d] + b.lo[d] * s0).min(fine_n[d] - 1)),
+        hi: [0, 1, 2].map(|d| (sub.origin[d] + b.hi[d] * s0).min(fine_n[d] - 1)),
     };
     // The cube: grown from the cubes at the first corner and at the middle of the coarse box
     // of the longest shortest edge and of the one that bounds the rest; the largest kept.
@@ -127,6 +192,40 @@ pub(crate) fn refined_largest_box(
         }
     }
     result
+}
+
+/// The largest box and cube of the fine lattice searched exhaustively within `bbox` (the fine
+/// index box of the inside points): every point of it examined with `inside_at`, then
+/// [`largest_box_by`] as on the uniform grid; the bounds are the volumes found.
+pub(crate) fn exact_largest_box(
+    bbox: GridBox,
+    inside_at: &(dyn Fn([usize; 3]) -> bool + Sync),
+) -> RefinedBox {
+    let n = bbox.edges().map(|e| e + 1);
+    let map: Vec<bool> = (0..n[2])
+        .into_par_iter()
+        .flat_map_iter(|k| {
+            (0..n[1]).flat_map(move |j| {
+                (0..n[0]).map(move |i| inside_at([bbox.lo[0] + i, bbox.lo[1] + j, bbox.lo[2] + k]))
+            })
+        })
+        .collect();
+    let at = |i: usize, j: usize, k: usize| map[i + n[0] * (j + n[1] * k)];
+    let hi = n.map(|v| v - 1);
+    let shifted = |b: GridBox| GridBox {
+        lo: [0, 1, 2].map(|d| b.lo[d] + bbox.lo[d]),
+        hi: [0, 1, 2].map(|d| b.hi[d] + bbox.lo[d]),
+    };
+    let found = largest_box_by(&at, [0; 3], hi, BoxMeasure::Volume).map(|(b, v)| (shifted(b), v));
+    let cube =
+        largest_box_by(&at, [0; 3], hi, BoxMeasure::Cube).map(|(b, v)| (shifted(cube_in(&b)), v));
+    RefinedBox {
+        found,
+        upper: found.map_or(0.0, |(_, v)| v),
+        cube,
+        cube_upper: cube.map_or(0.0, |(_, v)| v),
+        examined: map.len() as u64,
+    }
 }
 
 /// Grows the box `b` of the fine lattice (`fine_n` points along each axis) one face and one
