@@ -379,6 +379,79 @@ mod tests {
         }
     }
 
+    /// Critical points far apart (p' with b^2 >> 4ak): the stable form of the quadratic
+    /// formula keeps the small one accurate, so a close pair of roots beside it is split by
+    /// it and found; the form that subtracts nearly equal numbers misplaces it by more than
+    /// the pair's width.
+    #[test]
+    fn a_close_pair_beside_a_far_critical_point_is_found() {
+        for (pair, far) in [(1e-7f64, 1e7f64), (3e-5, -2e6), (-1e-6, 5e8)] {
+            let rs = [pair * (1.0 - 1e-4), pair * (1.0 + 1e-4), far];
+            let c = from_roots(rs, 1.0);
+            let (lo, hi) = (
+                pair.min(0.0) - 2.0 * pair.abs(),
+                pair.max(0.0) + 2.0 * pair.abs(),
+            );
+            let found = cubic_roots_in(&c, lo, hi);
+            assert_eq!(found.len(), 2, "{rs:?}: {found:?}");
+            let mut pair_roots = [rs[0], rs[1]];
+            pair_roots.sort_by(f64::total_cmp);
+            for (f, r) in found.iter().zip(&pair_roots) {
+                assert!((f.x - r).abs() <= 1e-9 * pair.abs(), "{rs:?}: {found:?}");
+            }
+        }
+    }
+
+    /// A critical point where p is above zero by more than its rounding is no root: the
+    /// error bound of p at x weighs c3 by |x|^3 (a small |x| and a large c3 here), not by c3
+    /// plus |x|.
+    #[test]
+    fn a_minimum_above_its_rounding_is_no_root() {
+        // p = 1e6 (x^3 - 3e-6 x) + d: a local minimum at x = 1e-3 of 1e-16, about ten times
+        // the rounding of p there (1.1e-17).
+        let d = 2e-3 + 1e-16;
+        let c = [d, -3.0, 0.0, 1e6];
+        let (p, err) = eval_with_error(&c, &[0.0; 4], 1e-3);
+        assert!(p > 5e-17 && err < 2e-17, "p {p:e}, bound {err:e}");
+        assert!(cubic_roots_in(&c, 0.0, 1.0).is_empty());
+        // Lowered by 2e-16 it crosses zero twice near the minimum.
+        let c = [d - 2e-16, -3.0, 0.0, 1e6];
+        assert_eq!(cubic_roots_in(&c, 0.0, 1.0).len(), 2);
+    }
+
+    /// Coefficients so large that the discriminant of p' is inf - inf go to the general
+    /// routine (an infinite one already fails the rounding test): the same roots at every
+    /// such scale.
+    #[test]
+    fn an_overflowing_discriminant_goes_to_the_general_routine() {
+        let roots = [0.5, 2.0, 3.0];
+        for scale in [1e160, 1e200, 1e250, 1e300] {
+            let c = from_roots(roots, 1.0).map(|v| v * scale);
+            let (a, b, k) = (3.0 * c[3], 2.0 * c[2], c[1]);
+            assert!((b * b - 4.0 * a * k).is_nan(), "{scale:e}");
+            let found = cubic_roots_in(&c, -5.0, 5.0);
+            assert_eq!(found.len(), 3, "{scale:e}: {found:?}");
+            for (f, r) in found.iter().zip(roots) {
+                assert!((f.x - r).abs() < 1e-12, "{scale:e}: {found:?}");
+            }
+        }
+    }
+
+    /// The deflated quadratic's roots far apart: the stable form keeps the small one, the one
+    /// in the interval, to rounding.
+    #[test]
+    fn deflation_keeps_a_small_root_beside_a_large_one() {
+        for (small, large) in [(1e-6f64, 1e6f64), (-3e-5, 4e6), (2e-4, -5e6)] {
+            let c = from_roots([-3.0, small, large], 1.0);
+            let roots = deflated_roots_in(&c, -3.0, -1.0, 1.0).unwrap();
+            assert_eq!(roots.len(), 1, "{small} {large}: {roots:?}");
+            assert!(
+                (roots[0] - small).abs() <= 1e-9 * small.abs(),
+                "{small} {large}: {roots:?}"
+            );
+        }
+    }
+
     /// The deflated roots are the isolator's, to rounding, whenever they decide.
     #[test]
     fn deflation_agrees_with_isolation() {
