@@ -379,10 +379,12 @@ pub struct WorkspaceArgs {
     pub slice: Vec<(usize, f64)>,
     /// Adaptive sampling: a coarse grid (8 steps), refined only where the workspace's boundary
     /// passes; the cost grows with the boundary, not the volume. The default below a 5 mm step
-    /// when no points CSV or picture is asked (they need every grid point).
+    /// when no points CSV or picture is asked (they need every grid point). For a glider, the
+    /// default from 513 nodes, with the points CSV and the picture of the uniform grid.
     #[arg(long, conflicts_with = "uniform")]
     pub adaptive: bool,
-    /// Every grid point classified (the default at 5 mm and above, and with -o or --plot).
+    /// Every grid point classified (the default at 5 mm and above, and with -o or --plot; for a
+    /// glider, below 513 nodes).
     #[arg(long)]
     pub uniform: bool,
     /// A design sweep: one adaptive workspace per value of a machine-file key, KEY=FROM..TO:N
