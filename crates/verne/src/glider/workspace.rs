@@ -12,7 +12,7 @@
 //! estimate from one pseudo-random point in each cell between, bounded by Hoeffding's
 //! inequality.
 
-use crate::math::splitmix::unit_offsets;
+use crate::math::sampling::{hoeffding_half_width, unit_offsets};
 use crate::par::*;
 use nalgebra::{Point2, Rotation2, Vector2};
 
@@ -33,9 +33,6 @@ const WINDOW_JOINT_SAMPLES: usize = 129;
 /// Margin added on each side of that window, as a fraction of its larger extent.
 const WINDOW_MARGIN_REL: f64 = 0.03;
 
-/// The confidence of the sampled area's half-width: 1 - delta = 99.7 %.
-pub const SAMPLED_CONFIDENCE_DELTA: f64 = 0.003;
-
 /// Which nodes of the grid are classified.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Sampling {
@@ -45,8 +42,8 @@ pub enum Sampling {
     Auto,
     /// Every node.
     Uniform,
-    /// A coarse grid of [`COARSE_FACTOR`] steps refined where the class changes
-    /// ([`super::adaptive`]).
+    /// A coarse grid of [`COARSE_FACTOR`] steps refined where the class or the binding
+    /// constraint changes ([`super::adaptive`]).
     Adaptive,
 }
 
@@ -437,10 +434,8 @@ fn estimate_region_area(
     };
     if boundary > 0 {
         let share = admissible as f64 / boundary as f64;
-        // Hoeffding: P(|share - mean| >= t) <= 2 exp(-2 n t^2) = delta.
-        let t = ((2.0 / SAMPLED_CONFIDENCE_DELTA).ln() / (2.0 * boundary as f64)).sqrt();
         e.sampled += share * boundary as f64 * cell;
-        e.half_width = t.min(1.0) * boundary as f64 * cell;
+        e.half_width = hoeffding_half_width(boundary as u64) * boundary as f64 * cell;
     }
     (e, boundary)
 }

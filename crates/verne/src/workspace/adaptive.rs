@@ -25,7 +25,7 @@
 //! with 99.7 % confidence, whatever the shape: `volume_sampled_mm3` +- `sampled_half_width_mm3`,
 //! about 0.004 % of the volume at 1 mm on the default machine for [`BOUNDARY_SAMPLES`] points.
 
-use crate::math::splitmix::{splitmix64, unit_offsets};
+use crate::math::sampling::{hoeffding_half_width, splitmix64, unit_offsets};
 use crate::par::*;
 use crate::spec::Machine;
 
@@ -40,8 +40,7 @@ pub const DEFAULT_COARSE_FACTOR: usize = 8;
 /// Boundary cells sampled, about (all of them when there are fewer).
 pub const BOUNDARY_SAMPLES: u64 = 200_000;
 
-/// The confidence of the sampled estimate's half-width: 1 - delta = 99.7 %.
-pub const SAMPLED_CONFIDENCE_DELTA: f64 = 0.003;
+pub use crate::math::sampling::SAMPLED_CONFIDENCE_DELTA;
 
 /// Up to this many fine lattice points in the box of the inside points, the largest box and
 /// cube are searched exhaustively on the fine lattice (exact, as on the uniform grid); above,
@@ -236,11 +235,8 @@ pub fn compute_adaptive_with(
     summary.volume_sampled_mm3 = summary.volume_lo_mm3;
     if summary.sampled_cells > 0 {
         let share = summary.sampled_inside as f64 / summary.sampled_cells as f64;
-        // Hoeffding: P(|share - mean| >= t) <= 2 exp(-2 n t^2) = delta.
-        let t =
-            ((2.0 / SAMPLED_CONFIDENCE_DELTA).ln() / (2.0 * summary.sampled_cells as f64)).sqrt();
         summary.volume_sampled_mm3 += share * boundary_mm3;
-        summary.sampled_half_width_mm3 = t.min(1.0) * boundary_mm3;
+        summary.sampled_half_width_mm3 = hoeffding_half_width(summary.sampled_cells) * boundary_mm3;
     }
     if summary.inside_points > 0 {
         summary.bbox = Some(Bounds {

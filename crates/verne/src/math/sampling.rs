@@ -1,5 +1,21 @@
-//! A deterministic hash for sampling: which cells of a lattice are sampled, and where, depend
-//! on the cell's key alone, so a sampled estimate is the same whatever the threads.
+//! Sampled estimates of the adaptive workspaces: a deterministic hash (which cells of a
+//! lattice are sampled, and where, depend on the cell's key alone, so an estimate is the same
+//! whatever the threads) and the confidence half-width of a share of sampled points.
+
+/// The confidence of a sampled estimate's half-width: 1 - delta = 99.7 %.
+pub const SAMPLED_CONFIDENCE_DELTA: f64 = 0.003;
+
+/// The half-width t of the 99.7 % confidence interval of the mean of `n` independent
+/// variables in [0, 1] (Hoeffding: P(|mean - expectation| >= t) <= 2 exp(-2 n t^2) = delta),
+/// at most 1; 1 for no sample.
+pub fn hoeffding_half_width(n: u64) -> f64 {
+    if n == 0 {
+        return 1.0;
+    }
+    ((2.0 / SAMPLED_CONFIDENCE_DELTA).ln() / (2.0 * n as f64))
+        .sqrt()
+        .min(1.0)
+}
 
 /// SplitMix64 (Steele, Lea, Flood 2014): a well-mixed 64-bit hash of the state, advanced.
 pub fn splitmix64(state: &mut u64) -> u64 {
@@ -21,6 +37,20 @@ mod tests {
 
     /// The first outputs of the reference implementation for seed 1234567
     /// (https://prng.di.unimi.it/splitmix64.c), and offsets spread over [0, 1).
+    #[test]
+    fn hoeffding_half_width_solves_its_inequality() {
+        for n in [1u64, 10, 1000, 200_000] {
+            let t = hoeffding_half_width(n);
+            let delta = 2.0 * (-2.0 * n as f64 * t * t).exp();
+            assert!(
+                t == 1.0 || (delta - SAMPLED_CONFIDENCE_DELTA).abs() < 1e-12,
+                "{n}"
+            );
+        }
+        assert_eq!(hoeffding_half_width(0), 1.0);
+        assert!((hoeffding_half_width(200_000) - 0.004_031_839).abs() < 1e-9);
+    }
+
     #[test]
     fn matches_the_reference_and_spreads() {
         let mut s = 1_234_567u64;
