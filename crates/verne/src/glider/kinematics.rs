@@ -8,6 +8,7 @@
 
 use std::fmt;
 
+use arrayvec::ArrayVec;
 use nalgebra::{Point2, Vector2};
 
 use super::spec::GliderSpec;
@@ -143,21 +144,28 @@ impl ForwardKinematics {
 /// Roots rho of |p - (o + rho u)| = l for a unit u, labelled by the sign of (p - c).u:
 /// rho = (p - o).u -/+ sqrt(l^2 - ((p - o) x u)^2) (section 2.3, Wenger 2001).
 /// Returns the `+` root then the `-` root, or one `Double` root, or nothing.
-pub fn strut_roots(o: Point2<f64>, u: Vector2<f64>, l: f64, p: Point2<f64>) -> Vec<(Branch, f64)> {
+pub fn strut_roots(
+    o: Point2<f64>,
+    u: Vector2<f64>,
+    l: f64,
+    p: Point2<f64>,
+) -> ArrayVec<(Branch, f64), 2> {
     let w = p - o;
     let along = w.dot(&u);
     let across = (w.x * u.y - w.y * u.x).abs();
     // (l - |x|)(l + |x|) keeps its accuracy near tangency, where l^2 - x^2 would cancel.
     let disc = (l - across) * (l + across);
     let tol = DOUBLE_ROOT_REL * l * l;
-    if disc < -tol {
-        Vec::new()
-    } else if disc <= tol {
-        vec![(Branch::Double, along)]
-    } else {
-        let r = disc.sqrt();
-        vec![(Branch::Plus, along - r), (Branch::Minus, along + r)]
+    let mut roots = ArrayVec::new();
+    match disc {
+        d if d < -tol => {}
+        d if d <= tol => roots.push((Branch::Double, along)),
+        d => {
+            let r = d.sqrt();
+            roots.extend([(Branch::Plus, along - r), (Branch::Minus, along + r)]);
+        }
     }
+    roots
 }
 
 /// The root of one strut on one branch, if it exists (a `Double` request only matches a double
