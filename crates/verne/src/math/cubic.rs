@@ -334,7 +334,7 @@ mod tests {
     #[test]
     fn bracketed_stays_in_its_bracket_when_halley_leaves_it() {
         let p = |c: &[f64; 4], x: f64| ((c[3] * x + c[2]) * x + c[1]) * x + c[0];
-        let cases: [([f64; 4], f64, f64); 3] = [
+        let cases: [([f64; 4], f64, f64); 6] = [
             (
                 [
                     -0.04345861414348768,
@@ -365,6 +365,38 @@ mod tests {
                 0.28113141265356956,
                 3.0,
             ),
+            // The secant point rounds onto an end (p(b) near rounding level): the midpoint
+            // start; 0.5 a b instead leaves the bracket for another root.
+            (
+                [
+                    0.0058042037054173955,
+                    0.9961899462346724,
+                    30.728798739992786,
+                    18.98169920115993,
+                ],
+                -1.0627825529955628,
+                -0.02537170963198746,
+            ),
+            (
+                [
+                    0.5167506192679999,
+                    11.770938420371316,
+                    66.50680472655166,
+                    21.058378653855474,
+                ],
+                -2.0129104041990353,
+                -0.11063219721187734,
+            ),
+            (
+                [
+                    -0.0006833847035556391,
+                    -0.028020655116685934,
+                    -0.2705181498595575,
+                    -0.1070770823562216,
+                ],
+                -1.6307685511431986,
+                -0.06864637937560651,
+            ),
         ];
         for (c, a, b) in cases {
             let (fa, fb) = (p(&c, a), p(&c, b));
@@ -376,6 +408,29 @@ mod tests {
             assert!(r.x >= a && r.x <= b, "{c:?}: {} outside [{a}, {b}]", r.x);
             let (v, err) = eval_with_error(&c, &[0.0; 4], r.x);
             assert!(v.abs() <= 2.0 * err, "{c:?}: p({}) = {v:e} > {err:e}", r.x);
+        }
+    }
+
+    /// An empty, reversed or not-a-number interval goes to the general routine: the same
+    /// answer (here none, or the root an interval of one point holds), never a root outside.
+    #[test]
+    fn a_degenerate_interval_answers_as_the_general_routine() {
+        let c = from_roots([-1.0, 0.5, 2.0], 1.0);
+        for (lo, hi) in [
+            (1.5, 0.0),
+            (3.0, -3.0),
+            (0.5, 0.5),
+            (1.0, 1.0),
+            (f64::NAN, 1.0),
+            (0.0, f64::NAN),
+        ] {
+            let fast: Vec<_> = cubic_roots_in(&c, lo, hi).into_iter().collect();
+            let slow: Vec<_> = roots_in(&c, lo, hi).into_iter().collect();
+            assert_eq!(fast, slow, "[{lo}, {hi}]");
+            assert!(
+                fast.iter().all(|r| r.x >= lo && r.x <= hi),
+                "[{lo}, {hi}]: {fast:?}"
+            );
         }
     }
 

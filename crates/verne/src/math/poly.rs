@@ -78,7 +78,8 @@ pub fn eval_with_coefficient_error(c: &[f64], err: &[f64], x: f64) -> (f64, f64)
     (p, rounding + coef)
 }
 
-/// All real roots of the polynomial `c` (lowest degree first) in [lo, hi], sorted.
+/// All real roots of the polynomial `c` (lowest degree first) in [lo, hi], sorted; none when
+/// the interval is empty (lo > hi) or an end is not a number.
 pub fn roots_in(c: &[f64], lo: f64, hi: f64) -> Roots {
     roots_in_with_error(c, &[], lo, hi)
 }
@@ -87,6 +88,14 @@ pub fn roots_in(c: &[f64], lo: f64, hi: f64) -> Roots {
 /// decisions (a sign change, a critical point touching zero) hold for the exact polynomial.
 pub fn roots_in_with_error(c: &[f64], err: &[f64], lo: f64, hi: f64) -> Roots {
     let mut out = Roots::new();
+    // An empty or not-a-number interval holds no root (the pieces below assume lo <= hi: a
+    // reversed interval bracketed a point that is no root).
+    if lo
+        .partial_cmp(&hi)
+        .is_none_or(|o| o == std::cmp::Ordering::Greater)
+    {
+        return out;
+    }
     let c = trimmed(c);
     let err = &err[..err.len().min(c.len())];
     if c.len() <= 1 {
@@ -241,6 +250,26 @@ mod tests {
         let got = roots_in(&c, -1.0, 1.0);
         assert_eq!(got.len(), 2, "{got:?}");
         assert_eq!(got[0].x, -1.0);
+    }
+
+    /// An empty (reversed) or not-a-number interval holds no root, at every degree; a
+    /// one-point interval holds its point when that is a root.
+    #[test]
+    fn an_empty_interval_holds_no_root() {
+        for rs in [
+            &[0.5][..],
+            &[-1.0, 0.5],
+            &[-1.0, 0.5, 2.0],
+            &[-1.0, -0.2, 0.5, 0.9, 2.0],
+        ] {
+            let c = from_roots(rs);
+            for (lo, hi) in [(1.5, 0.0), (3.0, -3.0), (f64::NAN, 1.0), (0.0, f64::NAN)] {
+                assert!(roots_in(&c, lo, hi).is_empty(), "{rs:?} on [{lo}, {hi}]");
+            }
+            let at = roots_in(&c, 0.5, 0.5);
+            assert_eq!(at.len(), 1, "{rs:?}: {at:?}");
+            assert_eq!(at[0].x, 0.5);
+        }
     }
 
     #[test]
