@@ -1,13 +1,13 @@
 //! A glider's workspace grid by adaptive sampling (a quadtree): classify a coarse grid, then
-//! halve only the cells whose four corners differ in class or in the constraint that binds
-//! (a refinement key a node, one byte) and, a guard against features thinner than a cell that
+//! halve only the cells whose four corners differ in class or in the constraint that binds (a
+//! refinement key a node, one byte) and, a guard against features thinner than a cell that
 //! reach out of a boundary, the cells next to them, down to cells of one step. A cell whose
-//! corners agree gives its key to the nodes it owns without classifying them. The classification's cost
-//! grows with the boundaries' length, not the area; the grid of classes is whole (one byte a
-//! node), so the flood fill, the area and the largest rectangle and square run on it exactly as
-//! on the uniform grid, whose classes it reproduces wherever no feature hides inside a coarse
-//! cell with agreeing corners (the coarse step bounds what can hide; tests compare with the
-//! uniform grid).
+//! corners agree gives its key to the nodes it owns without classifying them. The
+//! classification's cost grows with the boundaries' length, not the area; the grid of classes
+//! is whole (one byte a node), so the flood fill, the area and the largest rectangle and square
+//! run on it exactly as on the uniform grid, whose classes it reproduces wherever no feature
+//! hides inside a coarse cell with agreeing corners (the coarse step bounds what can hide;
+//! tests compare with the uniform grid).
 //!
 //! The fine grid is extended to a whole number of coarse cells for the refinement (nodes past
 //! the window, outside the image of the joint box), then cut back to the window.
