@@ -1,0 +1,447 @@
+//! `verne::verify`'s row checks through the library, without the CLI: the first rows of
+//! data/verify (a clean joint table and its intended path), each changed to break one check by
+//! a known amount; every finding's check, row, value and limit asserted, and a change within
+//! the limit asserted to find nothing. (The CLI's tests/verify.rs covers the same checks through
+//! the command; these run with the core crate's tests, so `cargo mutants -f
+//! crates/verne/src/verify/row.rs` measures them in seconds a mutant.)
+
+use std::collections::VecDeque;
+
+use nalgebra::{Rotation3, Unit, Vector3};
+use verne::spec::Machine;
+use verne::verify::{
+    Check, Item, JointSource, Joints, PairingError, PathPoint, RowSource, Summary, Thresholds,
+    VerifyOptions, Violation, verify,
+};
+
+/// Rows of data/verify read here.
+const ROWS: usize = 30;
+
+#[derive(Debug)]
+struct Fail(String);
+
+impl From<PairingError> for Fail {
+    fn from(e: PairingError) -> Fail {
+        Fail(format!("{e:?}"))
+    }
+}
+
+/// Rows held in memory.
+struct Rows<T> {
+    name: &'static str,
+    items: VecDeque<Item<T>>,
+}
+
+impl<T> RowSource for Rows<T> {
+    type Row = T;
+    type Error = Fail;
+    fn name(&self) -> &str {
+        self.name
+    }
+    fn has_id(&self) -> bool {
+        true
+    }
+    fn next_item(&mut self) -> Result<Option<Item<T>>, Fail> {
+        Ok(self.items.pop_front())
+    }
+}
+
+impl JointSource for Rows<Joints> {
+    fn timed(&self) -> bool {
+        true
+    }
+}
+
+/// The first `ROWS` data rows of a CSV of data/verify, as numbers (the id column first).
+fn table(file: &str) -> Vec<Vec<f64>> {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/verify/");
+    let text = std::fs::read_to_string(format!("{path}{file}")).unwrap();
+    text.lines()
+        .skip(1)
+        .take(ROWS)
+        .map(|l| l.split(',').map(|c| c.trim().parse().unwrap()).collect())
+        .collect()
+}
+
+fn item<T>(k: usize, value: Result<T, String>) -> Item<T> {
+    Item {
+        index: k as u64 + 1,
+        line: k as u64 + 2,
+        id: Some((k + 1).to_string()),
+        value,
+    }
+}
+
+/// The clean inputs: joints (id, t, rho1..3, theta1, theta2 in degrees) and path (id, tip,
+/// axis).
+fn clean() -> (Vec<Joints>, Vec<PathPoint>) {
+    let joints = table("joints.csv")
+        .iter()
+        .map(|r| Joints {
+            rho: Vector3::new(r[2], r[3], r[4]),
+            theta1: r[5].to_radians(),
+            theta2: r[6].to_radians(),
+            t: Some(r[1]),
+            feed: None,
+            duration: None,
+            rapid: false,
+        })
+        .collect();
+    let path = table("path.csv")
+        .iter()
+        .map(|r| {
+            PathPoint::new(
+                Vector3::new(r[1], r[2], r[3]),
+                Vector3::new(r[4], r[5], r[6]),
+            )
+        })
+        .collect();
+    (joints, path)
+}
+
+/// Runs verify on the rows (a joint row replaced by an error where `joints` holds one).
+fn run(
+    m: &Machine,
+    th: &Thresholds,
+    joints: Vec<Result<Joints, String>>,
+    path: Vec<PathPoint>,
+) -> (Summary, Vec<Violation>) {
+    let opt = VerifyOptions {
+        thresholds: *th,
+        tool_length: m.tool_length,
+    };
+    let mut j = Rows {
+        name: "joints",
+        items: joints
+            .into_iter()
+            .enumerate()
+            .map(|(k, v)| item(k, v))
+            .collect(),
+    };
+    let mut p = Rows {
+        name: "path",
+        items: path
+            .into_iter()
+            .enumerate()
+            .map(|(k, v)| item(k, Ok(v)))
+            .collect(),
+    };
+    let mut found = Vec::new();
+    let summary = verify(m, &opt, &mut j, &mut p, &mut |v: &Violation| {
+        found.push(v.clone());
+        Ok::<(), Fail>(())
+    })
+    .unwrap_or_else(|Fail(e)| panic!("{e}"));
+    (summary, found)
+}
+
+fn run_clean(m: &Machine, th: &Thresholds) -> (Summary, Vec<Violation>) {
+    let (joints, path) = clean();
+    run(m, th, joints.into_iter().map(Ok).collect(), path)
+}
+
+fn of(found: &[Violation], check: Check) -> Vec<&Violation> {
+    found.iter().filter(|v| v.check == check).collect()
+}
+
+fn machine(limits: &str) -> Machine {
+    Machine::from_toml_str(&format!("base = \"verne\"\n[limits]\n{limits}\n"), "test").unwrap()
+}
+
+#[test]
+fn the_clean_rows_find_nothing_and_measure_each_check() {
+    let m = Machine::default_verne();
+    let (summary, found) = run_clean(&m, &Thresholds::default());
+    assert!(found.is_empty(), "{found:?}");
+    assert_eq!(
+        (summary.rows, summary.segments),
+        (ROWS as u64, ROWS as u64 - 1)
+    );
+    // Every row check measured something within its limit.
+    for check in [
+        Check::TipError,
+        Check::AxisError,
+        Check::Limits,
+        Check::Singularity,
+    ] {
+        let (_, stats) = summary.checks.iter().find(|(c, _)| *c == check).unwrap();
+        let worst = stats.worst.as_ref().unwrap_or_else(|| panic!("{check:?}"));
+        assert_eq!(stats.count, 0);
+        assert!(
+            worst.value.is_finite() && worst.limit.is_finite(),
+            "{worst:?}"
+        );
+    }
+}
+
+#[test]
+fn a_tip_moved_beyond_its_limit_is_found_with_its_error() {
+    let m = Machine::default_verne();
+    let th = Thresholds::default();
+    let limit = th.get(verne::verify::Th::TipErrorMm);
+    let (joints, path) = clean();
+    for (scale, expect) in [(2.0, true), (0.5, false)] {
+        let mut path = path.clone();
+        let moved = Vector3::new(0.6, -0.8, 0.0) * limit * scale;
+        path[9].tip += moved;
+        let (_, found) = run(&m, &th, joints.iter().copied().map(Ok).collect(), path);
+        let tip = of(&found, Check::TipError);
+        if expect {
+            assert_eq!(tip.len(), 1, "{found:?}");
+            assert_eq!(tip[0].row, "10");
+            // The row's own fk tip is within rounding of the clean path's (the clean run finds
+            // nothing): the error is the move.
+            assert!(
+                (tip[0].value - moved.norm()).abs() < 1e-3 * limit,
+                "{:?}",
+                tip[0]
+            );
+            assert_eq!(tip[0].limit, limit);
+        } else {
+            assert!(tip.is_empty(), "{found:?}");
+        }
+    }
+}
+
+#[test]
+fn an_axis_turned_beyond_its_limit_is_found_with_its_angle() {
+    let m = Machine::default_verne();
+    let th = Thresholds::default();
+    let limit = th.get(verne::verify::Th::AxisErrorDeg);
+    let (joints, path) = clean();
+    for (scale, expect) in [(3.0, true), (0.4, false)] {
+        let mut path = path.clone();
+        let axis = path[4].axis;
+        let turn = Unit::new_normalize(axis.cross(&Vector3::x()));
+        path[4].axis = Rotation3::from_axis_angle(&turn, (limit * scale).to_radians()) * axis;
+        let (_, found) = run(&m, &th, joints.iter().copied().map(Ok).collect(), path);
+        let turned = of(&found, Check::AxisError);
+        if expect {
+            assert_eq!(turned.len(), 1, "{found:?}");
+            assert_eq!(turned[0].row, "5");
+            assert!(
+                (turned[0].value - limit * scale).abs() < 0.05 * limit,
+                "{:?}",
+                turned[0]
+            );
+            assert_eq!(turned[0].limit, limit);
+        } else {
+            assert!(turned.is_empty(), "{found:?}");
+        }
+    }
+}
+
+/// The row of the largest (or smallest) value of a joint, and the value and the next one.
+fn extreme(values: &[f64], largest: bool) -> (usize, f64, f64) {
+    let mut order: Vec<usize> = (0..values.len()).collect();
+    order.sort_by(|&a, &b| values[a].total_cmp(&values[b]));
+    if largest {
+        order.reverse();
+    }
+    (order[0], values[order[0]], values[order[1]])
+}
+
+#[test]
+fn strokes_and_the_tilting_range_are_found_with_their_ends() {
+    let (joints, _) = clean();
+    let rho1: Vec<f64> = joints.iter().map(|q| q.rho.x).collect();
+    let rho3: Vec<f64> = joints.iter().map(|q| q.rho.z).collect();
+    let theta1: Vec<f64> = joints.iter().map(|q| q.theta1.to_degrees()).collect();
+    // rho1 above a stroke end set between its largest and next value: that row only.
+    let (k, top, next) = extreme(&rho1, true);
+    let end = 0.5 * (top + next);
+    let (_, found) = run_clean(
+        &machine(&format!("rho1_max = {end}")),
+        &Thresholds::default(),
+    );
+    let lim = of(&found, Check::Limits);
+    assert_eq!(lim.len(), 1, "{found:?}");
+    assert_eq!(lim[0].row, (k + 1).to_string());
+    assert_eq!((lim[0].value, lim[0].limit), (top, end));
+    assert!((lim[0].severity - (1.0 + top - end)).abs() < 1e-9);
+    assert!(
+        lim[0].detail.contains("rho1") && lim[0].detail.contains("above"),
+        "{}",
+        lim[0].detail
+    );
+    // rho3 below a stroke start.
+    let (k, low, next) = extreme(&rho3, false);
+    let start = 0.5 * (low + next);
+    let (_, found) = run_clean(
+        &machine(&format!("rho3_min = {start}")),
+        &Thresholds::default(),
+    );
+    let lim = of(&found, Check::Limits);
+    assert_eq!(lim.len(), 1, "{found:?}");
+    assert_eq!(lim[0].row, (k + 1).to_string());
+    assert_eq!((lim[0].value, lim[0].limit), (low, start));
+    assert!(
+        lim[0].detail.contains("rho3") && lim[0].detail.contains("below"),
+        "{}",
+        lim[0].detail
+    );
+    // theta1 above its range (degrees in the finding).
+    let (k, top, next) = extreme(&theta1, true);
+    let end = 0.5 * (top + next);
+    let (_, found) = run_clean(
+        &machine(&format!("theta1_max = {end}")),
+        &Thresholds::default(),
+    );
+    let lim = of(&found, Check::Limits);
+    assert_eq!(lim.len(), 1, "{found:?}");
+    assert_eq!(lim[0].row, (k + 1).to_string());
+    assert!((lim[0].value - top).abs() < 1e-9 && (lim[0].limit - end).abs() < 1e-9);
+    assert!((lim[0].severity - (1.0 + top - end)).abs() < 1e-9);
+}
+
+#[test]
+fn a_rod_tilted_beyond_its_limit_is_found_with_its_tilt() {
+    // The clean run's largest tilt (its worst Limits measurement), then a limit just below it.
+    let m = Machine::default_verne();
+    let (summary, _) = run_clean(&m, &Thresholds::default());
+    let (_, stats) = summary
+        .checks
+        .iter()
+        .find(|(c, _)| *c == Check::Limits)
+        .unwrap();
+    let tilt = stats.worst.as_ref().unwrap().value;
+    assert!(tilt > 1.0 && tilt < 60.0, "{tilt}");
+    let limit = tilt - 0.01;
+    let (_, found) = run_clean(
+        &machine(&format!("rod_tilt_max = {limit}")),
+        &Thresholds::default(),
+    );
+    let lim = of(&found, Check::Limits);
+    assert!(!lim.is_empty(), "{found:?}");
+    let worst = lim
+        .iter()
+        .max_by(|a, b| a.value.total_cmp(&b.value))
+        .unwrap();
+    assert!((worst.value - tilt).abs() < 1e-9, "{worst:?}");
+    assert!((worst.limit - limit).abs() < 1e-9);
+    assert!(worst.detail.starts_with("rod "), "{}", worst.detail);
+    assert!(lim.iter().all(|v| v.value > limit - 1e-9), "{lim:?}");
+}
+
+#[test]
+fn amplification_and_parallel_margin_limits_are_found_with_their_values() {
+    let m = Machine::default_verne();
+    let (summary, _) = run_clean(&m, &Thresholds::default());
+    let (_, stats) = summary
+        .checks
+        .iter()
+        .find(|(c, _)| *c == Check::Singularity)
+        .unwrap();
+    assert!(stats.worst.is_some());
+    // Thresholds that every row breaks: the largest factor above a tiny ceiling, the smallest
+    // below a floor above it, the margin below a floor of 1.
+    for (name, expect) in [
+        ("lambda_max", "largest amplification factor"),
+        ("lambda_min", "smallest amplification factor"),
+        ("parallel_margin_min", "parallel margin"),
+    ] {
+        let mut th = Thresholds::default();
+        let value = match name {
+            "lambda_max" => 0.01,
+            "lambda_min" => 50.0,
+            _ => 0.999,
+        };
+        th.set(name, value).unwrap();
+        let (_, found) = run_clean(&m, &th);
+        let sing: Vec<_> = of(&found, Check::Singularity)
+            .into_iter()
+            .filter(|v| v.detail.contains(expect))
+            .collect();
+        assert!(sing.len() >= ROWS, "{name}: {} of {found:?}", sing.len());
+        for v in sing {
+            assert_eq!(v.limit, value, "{v:?}");
+            let broken = match name {
+                "lambda_max" => v.value > value,
+                _ => v.value < value,
+            };
+            assert!(broken && v.value.is_finite(), "{v:?}");
+        }
+    }
+}
+
+#[test]
+fn joints_that_cannot_be_assembled_a_bad_row_and_a_missing_id_are_findings() {
+    let m = Machine::default_verne();
+    let (joints, mut path) = clean();
+    let mut rows: Vec<Result<Joints, String>> = joints.iter().copied().map(Ok).collect();
+    // Sliders apart: assembled only in modes of other kinds; and too far apart for the rods.
+    let mut apart = joints[3];
+    apart.rho = Vector3::new(0.0, 1100.0, 0.0);
+    rows[3] = Ok(apart);
+    apart.rho = Vector3::new(0.0, 5000.0, 0.0);
+    rows[12] = Ok(apart);
+    rows[7] = Err("rho2: `x` is not a number".into());
+    // The path has no row 20 (the joint row 20 has no intended pose).
+    path.remove(19);
+    let mut path_rows = Rows {
+        name: "path",
+        items: path
+            .into_iter()
+            .enumerate()
+            .map(|(k, v)| item(if k >= 19 { k + 1 } else { k }, Ok(v)))
+            .collect(),
+    };
+    let mut joint_rows = Rows {
+        name: "joints",
+        items: rows
+            .into_iter()
+            .enumerate()
+            .map(|(k, v)| item(k, v))
+            .collect(),
+    };
+    let opt = VerifyOptions {
+        thresholds: Thresholds::default(),
+        tool_length: m.tool_length,
+    };
+    let mut found = Vec::new();
+    let summary = verify(
+        &m,
+        &opt,
+        &mut joint_rows,
+        &mut path_rows,
+        &mut |v: &Violation| {
+            found.push(v.clone());
+            Ok::<(), Fail>(())
+        },
+    )
+    .unwrap_or_else(|Fail(e)| panic!("{e}"));
+    let branch = of(&found, Check::Branch);
+    assert_eq!(branch.len(), 2, "{found:?}");
+    assert_eq!((branch[0].row.as_str(), branch[0].value), ("4", 4.0));
+    assert!(
+        branch[0]
+            .detail
+            .contains("no assembly mode of the machine's kind")
+            && branch[0].detail.contains("4 real"),
+        "{}",
+        branch[0].detail
+    );
+    assert_eq!((branch[1].row.as_str(), branch[1].value), ("13", 0.0));
+    assert!(
+        branch[1].detail.contains("cannot be assembled"),
+        "{}",
+        branch[1].detail
+    );
+    let input = of(&found, Check::Input);
+    assert_eq!(input.len(), 1, "{found:?}");
+    assert_eq!(input[0].row, "8");
+    assert!(input[0].detail.contains("line 9") && input[0].detail.contains("rho2"));
+    let pairing = of(&found, Check::Pairing);
+    assert_eq!(pairing.len(), 1, "{found:?}");
+    assert_eq!(pairing[0].row, "20");
+    assert!(pairing[0].detail.contains("`20`"), "{}", pairing[0].detail);
+    // Rows 4, 8 and 13 leave the segments on both sides unchecked (6), the unpaired row 20
+    // the one before it (7); the gap after it starts the chain anew (no segment 20-21):
+    // 29 = 21 checked + 7 skipped + 1 not formed.
+    assert_eq!(
+        (summary.segments, summary.segments_skipped),
+        (21, 7),
+        "{summary:?}"
+    );
+    assert_eq!(found.len(), 4, "{found:?}");
+}
