@@ -388,8 +388,9 @@ pub struct WorkspaceArgs {
     #[arg(long)]
     pub uniform: bool,
     /// A design sweep: one adaptive workspace per value of a machine-file key, KEY=FROM..TO:N
-    /// (e.g. module.L1=800..900:11, tool.length=0..150:7); twice for a grid of two keys. Writes
-    /// a CSV table (-o, or stdout): the key values, volume, bracket, bounding box, cost.
+    /// (e.g. module.L1=800..900:11, tool.length=0..150:7; a glider's alpha1_deg, alpha2_deg,
+    /// l1, l2 or l0); twice for a grid of two keys. Writes a CSV table (-o, or stdout): the key
+    /// values, volume (a glider's area), bracket, largest box (S), cost.
     #[arg(long, value_name = "KEY=FROM..TO:N", value_parser = crate::arg_values::parse_sweep)]
     pub sweep: Vec<(String, f64, f64, usize)>,
     #[command(flatten)]

@@ -594,7 +594,8 @@ fn modes_plot_draws_every_branch_of_a_glider() {
 
 /// `verne workspace -m GLIDER`: the adaptive grid writes the uniform grid's points CSV byte
 /// for byte, and the same summary but for the count of points classified (fewer); the default
-/// at 801 nodes is adaptive; the VERNE machine's options are refused, not ignored.
+/// at 801 nodes is adaptive; the VERNE machine's options are refused, not ignored (and a
+/// sweep of a VERNE key: `glider_sweep_rows_are_the_workspaces_of_those_gliders`).
 #[test]
 fn glider_workspace_adaptive_writes_what_the_uniform_grid_writes() {
     let dir = std::env::temp_dir().join(format!("verne-glider-adaptive-{}", std::process::id()));
@@ -658,7 +659,6 @@ fn glider_workspace_adaptive_writes_what_the_uniform_grid_writes() {
         &["--bounds", "0,1,0,1,0,1"],
         &["--inside-only", "-o", "-"],
         &["--slice", "z=1", "--plot", "x.svg"],
-        &["--sweep", "tool.length=0..10:2"],
     ] {
         let mut args = vec!["workspace", "-m", "biglide1"];
         args.extend_from_slice(refused);
@@ -673,5 +673,157 @@ fn glider_workspace_adaptive_writes_what_the_uniform_grid_writes() {
             stderr(&out)
         );
     }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `verne workspace -m GLIDER --sweep KEY=FROM..TO:N`: each row is `verne workspace` of the
+/// glider file with that value (area, its bracket, S and the largest square, as the summary
+/// prints them); two keys make a grid; the picture is drawn; a key a glider file has no
+/// number for, or a value that makes an invalid glider, is refused before anything runs; an
+/// empty workspace gives empty cells and exit 1.
+#[test]
+fn glider_sweep_rows_are_the_workspaces_of_those_gliders() {
+    let dir = std::env::temp_dir().join(format!("verne-glider-sweep-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (csv, svg) = (dir.join("sweep.csv"), dir.join("sweep.svg"));
+    let out = run(
+        &[
+            "workspace",
+            "-m",
+            "orthoglide",
+            "--sweep",
+            "l0=1.8..2.1:4",
+            "-o",
+            csv.to_str().unwrap(),
+            "--plot",
+            svg.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let (header, rows) = common::table(&text);
+    assert_eq!(rows.len(), 4);
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    assert_eq!(
+        rows.iter().map(|r| r[0].as_str()).collect::<Vec<_>>(),
+        ["1.8", "1.9", "2", "2.1"]
+    );
+    let template =
+        String::from_utf8(run(&["machine", "show", "--base", "orthoglide"], None).stdout).unwrap();
+    for row in &rows {
+        let file = dir.join(format!("l0_{}.toml", row[0]));
+        let body: String = template
+            .lines()
+            .map(|l| {
+                if l.starts_with("l0 =") {
+                    format!("l0 = {}", row[0])
+                } else {
+                    l.to_string()
+                }
+            })
+            .collect::<Vec<_>>()
+            .join("\n");
+        std::fs::write(&file, body).unwrap();
+        let one = run(&["workspace", "-m", file.to_str().unwrap()], None);
+        assert_eq!(one.status.code(), Some(0), "{}", stderr(&one));
+        let summary = stderr(&one);
+        let number_after = |line_start: &str, after: &str| -> String {
+            let line = summary
+                .lines()
+                .find(|l| l.trim_start().starts_with(line_start))
+                .unwrap();
+            let rest = &line[line.find(after).unwrap() + after.len()..];
+            rest.split([' ', ';', ',', ')']).next().unwrap().to_string()
+        };
+        assert_eq!(
+            row[col("region_area")],
+            number_after("t-connected region", "area ")
+        );
+        assert_eq!(
+            row[col("area_lo")],
+            number_after("t-connected region", "between ")
+        );
+        assert_eq!(
+            row[col("area_hi")],
+            number_after("t-connected region", " and ")
+        );
+        assert_eq!(
+            row[col("sampled_area")],
+            number_after("t-connected region", "sampled ")
+        );
+        assert_eq!(row[col("s_area")], number_after("largest rectangle", " = "));
+        assert_eq!(
+            row[col("square_area")],
+            number_after("largest square", " = ")
+        );
+    }
+    let picture = std::fs::read_to_string(&svg).unwrap();
+    assert!(picture.contains("t-connected region") && picture.contains("S, largest rectangle"));
+    // Two keys: a grid, the second key fastest.
+    let out = run(
+        &[
+            "workspace",
+            "-m",
+            "orthoglide",
+            "--sweep",
+            "l0=1.9..2:2",
+            "--sweep",
+            "l2=0.95..1.05:3",
+        ],
+        None,
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let (header, rows) = common::table(&String::from_utf8(out.stdout).unwrap());
+    assert_eq!(&header[..2], ["l0", "l2"]);
+    let keys: Vec<(&str, &str)> = rows
+        .iter()
+        .map(|r| (r[0].as_str(), r[1].as_str()))
+        .collect();
+    assert_eq!(
+        keys,
+        [
+            ("1.9", "0.95"),
+            ("1.9", "1"),
+            ("1.9", "1.05"),
+            ("2", "0.95"),
+            ("2", "1"),
+            ("2", "1.05")
+        ]
+    );
+    // Refused before anything runs: no output file.
+    let refused = dir.join("refused.csv");
+    for (sweep, message) in [
+        (
+            "rho1_range=0..1:2",
+            "numeric keys are alpha1_deg, alpha2_deg, l1, l2, l0",
+        ),
+        ("l1=-1..1:3", "l1=-1: the glider is invalid"),
+    ] {
+        let out = run(
+            &[
+                "workspace",
+                "-m",
+                "orthoglide",
+                "--sweep",
+                sweep,
+                "-o",
+                refused.to_str().unwrap(),
+            ],
+            None,
+        );
+        assert_eq!(out.status.code(), Some(2), "{sweep}");
+        assert!(stderr(&out).contains(message), "{sweep}: {}", stderr(&out));
+        assert!(!refused.exists(), "{sweep}");
+    }
+    // The guides too far apart for the struts: an empty workspace, empty cells, exit 1.
+    let out = run(
+        &["workspace", "-m", "orthoglide", "--sweep", "l0=2..9:2"],
+        None,
+    );
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    let (header, rows) = common::table(&String::from_utf8(out.stdout).unwrap());
+    let s = header.iter().position(|h| h == "s_area").unwrap();
+    assert!(!rows[0][s].is_empty() && rows[1][s].is_empty(), "{rows:?}");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use crate::error::VerneError;
-use crate::plot::sweep::{SweepPoint, sweep_picture};
+use crate::plot::sweep::{SweepPoint, VOLUME_LABELS, sweep_picture};
 use crate::plot::{self, View};
 use crate::report::workspace::{POINTS_HEADER, write_point};
 use crate::table::Sink;
@@ -39,32 +39,14 @@ fn run_sweep(
     bounds: Option<Bounds>,
     lambda: [f64; 2],
 ) -> Result<u8, VerneError> {
-    let values = |(_, from, to, n): &(String, f64, f64, usize)| -> Vec<f64> {
-        (0..*n)
-            .map(|k| {
-                if *n == 1 {
-                    *from
-                } else {
-                    from + (to - from) * k as f64 / (*n - 1) as f64
-                }
-            })
-            .collect()
-    };
     let keys: Vec<&str> = args.sweep.iter().map(|s| s.0.as_str()).collect();
-    let mut points: Vec<Vec<f64>> = values(&args.sweep[0])
-        .into_iter()
-        .map(|v| vec![v])
-        .collect();
-    if let Some(second) = args.sweep.get(1) {
-        points = points
-            .into_iter()
-            .flat_map(|p| {
-                values(second)
-                    .into_iter()
-                    .map(move |v| [p.clone(), vec![v]].concat())
-            })
-            .collect();
+    if let Some(key) = keys.iter().find(|k| !k.contains('.')) {
+        return Err(VerneError::Usage(format!(
+            "--sweep {key}: the key of a machine file, section.key (e.g. module.L1, \
+             tool.length)"
+        )));
     }
+    let points = crate::arg_values::sweep_points(&args.sweep);
     let base = machine.to_toml();
     let resolve = |_: &str| -> Result<(String, String), String> {
         Ok((base.clone(), "the machine swept".to_string()))
@@ -214,7 +196,7 @@ fn run_sweep(
             machine.name,
             keys.join(" and ")
         );
-        sweep_picture(path, &keys, &drawn, &title)
+        sweep_picture(path, &keys, &drawn, &title, &VOLUME_LABELS)
             .map_err(|e| VerneError::io(&path.display().to_string(), std::io::Error::other(e)))?;
     }
     Ok(if any_empty { EXIT_ROWS_FAILED } else { EXIT_OK })
@@ -328,13 +310,12 @@ pub fn run(args: &WorkspaceArgs) -> Result<u8, VerneError> {
             ("--bounds", args.bounds.is_some()),
             ("--inside-only", args.inside_only),
             ("--slice", !args.slice.is_empty()),
-            ("--sweep", !args.sweep.is_empty()),
         ];
         if let Some((flag, _)) = not_for_a_glider.iter().find(|(_, given)| *given) {
             return Err(VerneError::Usage(format!(
                 "{flag} applies to the VERNE machine's workspace, not to a glider's (`{}`): \
-                 a glider's takes --step, --lambda, --adaptive or --uniform, -o and --plot \
-                 (docs/gliders.md)",
+                 a glider's takes --step, --lambda, --adaptive or --uniform, --sweep, -o and \
+                 --plot (docs/gliders.md)",
                 spec.name
             )));
         }
@@ -343,9 +324,21 @@ pub fn run(args: &WorkspaceArgs) -> Result<u8, VerneError> {
             (_, true) => Sampling::Uniform,
             _ => Sampling::Auto,
         };
+        let size = args.step.map_or(GridSize::Default, GridSize::Step);
+        if !args.sweep.is_empty() {
+            return super::glider::workspace_sweep(
+                &spec,
+                &args.sweep,
+                size,
+                Some(args.lambda.unwrap_or(PAPER_LAMBDA_BOUNDS)),
+                sampling,
+                args.output.as_deref(),
+                args.plot.as_deref(),
+            );
+        }
         return super::glider::workspace(
             &spec,
-            args.step.map_or(GridSize::Default, GridSize::Step),
+            size,
             Some(args.lambda.unwrap_or(PAPER_LAMBDA_BOUNDS)),
             sampling,
             args.output.as_deref(),

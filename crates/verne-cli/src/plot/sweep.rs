@@ -1,7 +1,7 @@
 //! The picture of a design sweep (`verne workspace --sweep ... --plot`): two panels against the
-//! first key, the workspace volume with its bracket as a bar at each value, and the largest box
-//! with its bound as a bar (the box found .. no box of the lattice is larger); one line per
-//! value of the second key when there is one.
+//! first key, the workspace volume (a glider's area) with its bracket as a bar at each value,
+//! and the largest box with its bound as a bar (the box found .. no box of the lattice is
+//! larger; a glider's S); one line per value of the second key when there is one.
 
 use std::path::Path;
 
@@ -11,7 +11,7 @@ use plotters::prelude::*;
 use super::{FAMILY, Format, draw_title_and_legend, drawing, io_err, register_font};
 
 /// One workspace of a sweep: its key values, the volume and its bracket, the largest box found
-/// and the volume no box exceeds (litres).
+/// and the volume no box exceeds (litres; a glider's area and S, in its length unit squared).
 pub struct SweepPoint {
     pub keys: Vec<f64>,
     pub volume_l: f64,
@@ -48,6 +48,25 @@ const SERIES: [RGBColor; 6] = [
     RGBColor(140, 86, 75),
 ];
 
+/// What the picture calls its two quantities.
+pub struct SweepLabels {
+    /// The first panel's axis, and the legend's name for it.
+    pub volume_axis: &'static str,
+    pub volume_name: &'static str,
+    /// The second panel's axis.
+    pub box_axis: &'static str,
+    /// The legend's line about the bars.
+    pub bars: &'static str,
+}
+
+/// The VERNE machine's sweep.
+pub const VOLUME_LABELS: SweepLabels = SweepLabels {
+    volume_axis: "workspace volume (l)",
+    volume_name: "volume",
+    box_axis: "largest box (l)",
+    bars: "bars: the volume's bracket; the largest box found .. no box of the lattice larger",
+};
+
 const SIZE: (u32, u32) = (1200, 620);
 const LEGEND_HEIGHT_PX: u32 = 86;
 
@@ -57,12 +76,16 @@ pub fn sweep_picture(
     keys: &[&str],
     points: &[SweepPoint],
     title: &str,
+    labels: &SweepLabels,
 ) -> Result<(), String> {
     if !points
         .iter()
         .any(|p| p.volume_l.is_finite() && p.volume_l > 0.0)
     {
-        return Err("nothing to draw: no workspace of the sweep has a volume".into());
+        return Err(format!(
+            "nothing to draw: no workspace of the sweep has a {}",
+            labels.volume_name
+        ));
     }
     // The series: one per value of the second key, in order of appearance.
     let mut series: Vec<Option<f64>> = Vec::new();
@@ -78,15 +101,14 @@ pub fn sweep_picture(
         .map(|(k, s)| {
             let label = match (s, keys.get(1)) {
                 (Some(v), Some(key)) => format!("{key} = {v}"),
-                _ => "volume".to_string(),
+                _ => labels.volume_name.to_string(),
             };
             (SERIES[k % SERIES.len()], false, label)
         })
         .chain(std::iter::once((
             RGBColor(90, 90, 90),
             true,
-            "bars: the volume's bracket; the largest box found .. no box of the lattice larger"
-                .to_string(),
+            labels.bars.to_string(),
         )))
         .collect();
     render!(
@@ -97,8 +119,22 @@ pub fn sweep_picture(
             let (top, body) = root.split_vertically(LEGEND_HEIGHT_PX);
             draw_title_and_legend(&top, title, &entries)?;
             let (left, right) = body.split_horizontally(SIZE.0 / 2);
-            draw_panel(&left, keys[0], points, &series, Panel::Volume)?;
-            draw_panel(&right, keys[0], points, &series, Panel::LargestBox)
+            draw_panel(
+                &left,
+                keys[0],
+                points,
+                &series,
+                labels.volume_axis,
+                Panel::Volume,
+            )?;
+            draw_panel(
+                &right,
+                keys[0],
+                points,
+                &series,
+                labels.box_axis,
+                Panel::LargestBox,
+            )
         }
     )
 }
@@ -109,6 +145,7 @@ fn draw_panel<DB: DrawingBackend>(
     key: &str,
     points: &[SweepPoint],
     series: &[Option<f64>],
+    axis: &str,
     panel: Panel,
 ) -> Result<(), String> {
     let (x0, x1) = points
@@ -147,10 +184,7 @@ fn draw_panel<DB: DrawingBackend>(
         .map_err(drawing)?;
     c.configure_mesh()
         .x_desc(key)
-        .y_desc(match panel {
-            Panel::Volume => "workspace volume (l)",
-            Panel::LargestBox => "largest box (l)",
-        })
+        .y_desc(axis)
         .label_style((FAMILY, 12))
         .axis_desc_style((FAMILY, 13))
         .draw()

@@ -15,8 +15,10 @@ use verne::glider::{
     jacobians, mode_label, verdict,
 };
 
+pub mod sweep;
 pub mod workspace;
 
+pub use sweep::workspace_sweep;
 pub use workspace::workspace;
 
 use super::{EXIT_OK, EXIT_ROWS_FAILED, run_rows, units, write_stdout};

@@ -92,58 +92,9 @@ pub fn workspace(
         sampling,
         ..WorkspaceOptions::default()
     };
-    let nodes = match size {
-        GridSize::Step(s) => {
-            if !(s.is_finite() && s > 0.0) {
-                return Err(VerneError::Usage(format!(
-                    "step {s}: expected a length > 0"
-                )));
-            }
-            // A two-node grid spans the window: its step is the window's longer side.
-            let window = sample_workspace(
-                spec,
-                &WorkspaceOptions {
-                    nodes: 2,
-                    ..base.clone()
-                },
-            )
-            .step;
-            let n = (window / s).ceil() + 1.0;
-            if n > WORKSPACE_MAX_NODES as f64 {
-                return Err(VerneError::Usage(format!(
-                    "step {s}: {n} nodes along the {window:.4} window, more than the \
-                     {WORKSPACE_MAX_NODES} allowed; give a larger step"
-                )));
-            }
-            n.max(2.0) as usize
-        }
-        GridSize::Nodes(n) => {
-            if !(2..=WORKSPACE_MAX_NODES).contains(&n) {
-                return Err(VerneError::Usage(format!(
-                    "{n} nodes: expected 2 to {WORKSPACE_MAX_NODES}"
-                )));
-            }
-            n
-        }
-        GridSize::Default => WORKSPACE_DEFAULT_NODES,
-    };
+    let nodes = nodes_for(spec, size, &base)?;
     let opts = WorkspaceOptions { nodes, ..base };
-    let grid = sample_workspace(spec, &opts);
-    // S and the largest square: the better of the two orientations of docs/gliders.md.
-    let turned = sample_workspace(
-        spec,
-        &WorkspaceOptions {
-            frame_angle: std::f64::consts::FRAC_PI_4,
-            ..opts.clone()
-        },
-    );
-    let best = |f: fn(&WorkspaceGrid) -> Option<Rectangle>| -> Option<Rectangle> {
-        match (f(&grid), f(&turned)) {
-            (Some(a), Some(b)) => Some(if b.area() > a.area() { b } else { a }),
-            (a, b) => a.or(b),
-        }
-    };
-    let (rect, square) = (best(largest_rectangle), best(largest_square));
+    let (grid, rect, square) = analyse(spec, &opts);
 
     if let Some(out) = output {
         write_workspace_points(spec, &grid, &opts, out, units)?;
@@ -249,6 +200,74 @@ pub fn workspace(
     } else {
         EXIT_ROWS_FAILED
     })
+}
+
+/// The grid's nodes along the window's longer side for `size` (the window is the image of the
+/// joint box of `spec`, so a step gives more nodes on a larger machine).
+pub(super) fn nodes_for(
+    spec: &GliderSpec,
+    size: GridSize,
+    base: &WorkspaceOptions,
+) -> Result<usize, VerneError> {
+    Ok(match size {
+        GridSize::Step(s) => {
+            if !(s.is_finite() && s > 0.0) {
+                return Err(VerneError::Usage(format!(
+                    "step {s}: expected a length > 0"
+                )));
+            }
+            // A two-node grid spans the window: its step is the window's longer side.
+            let window = sample_workspace(
+                spec,
+                &WorkspaceOptions {
+                    nodes: 2,
+                    ..base.clone()
+                },
+            )
+            .step;
+            let n = (window / s).ceil() + 1.0;
+            if n > WORKSPACE_MAX_NODES as f64 {
+                return Err(VerneError::Usage(format!(
+                    "step {s}: {n} nodes along the {window:.4} window, more than the \
+                     {WORKSPACE_MAX_NODES} allowed; give a larger step"
+                )));
+            }
+            n.max(2.0) as usize
+        }
+        GridSize::Nodes(n) => {
+            if !(2..=WORKSPACE_MAX_NODES).contains(&n) {
+                return Err(VerneError::Usage(format!(
+                    "{n} nodes: expected 2 to {WORKSPACE_MAX_NODES}"
+                )));
+            }
+            n
+        }
+        GridSize::Default => WORKSPACE_DEFAULT_NODES,
+    })
+}
+
+/// The workspace grid of `opts`, and S and the largest square: the better of the two
+/// orientations of docs/gliders.md (the grid as given, and turned by 45 deg).
+pub(super) fn analyse(
+    spec: &GliderSpec,
+    opts: &WorkspaceOptions,
+) -> (WorkspaceGrid, Option<Rectangle>, Option<Rectangle>) {
+    let grid = sample_workspace(spec, opts);
+    let turned = sample_workspace(
+        spec,
+        &WorkspaceOptions {
+            frame_angle: std::f64::consts::FRAC_PI_4,
+            ..opts.clone()
+        },
+    );
+    let best = |f: fn(&WorkspaceGrid) -> Option<Rectangle>| -> Option<Rectangle> {
+        match (f(&grid), f(&turned)) {
+            (Some(a), Some(b)) => Some(if b.area() > a.area() { b } else { a }),
+            (a, b) => a.or(b),
+        }
+    };
+    let (rect, square) = (best(largest_rectangle), best(largest_square));
+    (grid, rect, square)
 }
 
 fn write_workspace_points(
