@@ -334,7 +334,7 @@ mod tests {
     #[test]
     fn bracketed_stays_in_its_bracket_when_halley_leaves_it() {
         let p = |c: &[f64; 4], x: f64| ((c[3] * x + c[2]) * x + c[1]) * x + c[0];
-        let cases: [([f64; 4], f64, f64); 6] = [
+        let cases: [([f64; 4], f64, f64); 10] = [
             (
                 [
                     -0.04345861414348768,
@@ -397,6 +397,50 @@ mod tests {
                 -1.6307685511431986,
                 -0.06864637937560651,
             ),
+            // A secant point on an end kept as the start (the guard's `!` deleted, or `>` as
+            // `>=`), a midpoint 0.5 + (a + b), a step beyond a accepted (`next > a` as
+            // `next < a`): each ends outside its bracket or off the root on one of these
+            // (found by the same search).
+            (
+                [
+                    2.6882296147329855e-07,
+                    0.0002182438011259801,
+                    0.05906037686139519,
+                    5.327571063800048,
+                ],
+                -0.003694891586839332,
+                0.929477455929554,
+            ),
+            (
+                [
+                    -1.3944234949291775e-05,
+                    0.007344316744884802,
+                    -1.289397579086972,
+                    75.4572627098494,
+                ],
+                0.005696163597819528,
+                0.4280733083345863,
+            ),
+            (
+                [
+                    -5.788467027601219e-07,
+                    -0.0006520952959404948,
+                    -0.2448709780491649,
+                    -30.650834946247922,
+                ],
+                -0.1555209854884664,
+                -0.0026630806160470666,
+            ),
+            (
+                [
+                    -27.237528205335906,
+                    76.59000608520242,
+                    -71.78856300529563,
+                    22.429374444793684,
+                ],
+                1.0669076452278796,
+                1.6021128764201191,
+            ),
         ];
         for (c, a, b) in cases {
             let (fa, fb) = (p(&c, a), p(&c, b));
@@ -409,6 +453,38 @@ mod tests {
             let (v, err) = eval_with_error(&c, &[0.0; 4], r.x);
             assert!(v.abs() <= 2.0 * err, "{c:?}: p({}) = {v:e} > {err:e}", r.x);
         }
+    }
+
+    /// Critical points within rounding of a double one (p = (x - r)^3 + d (x - r) + g with d
+    /// near zero: a near-triple root or an inflection with a tiny slope) go to the general
+    /// routine: the same roots, where the closed form's discriminant has no reliable sign.
+    #[test]
+    fn near_double_critical_points_agree_with_the_general_routine() {
+        let mut cases = 0;
+        for r in [-2.0, 0.3, 1.7] {
+            for lead in [1.0, -3.0] {
+                for d in [0.0, 1e-17, -1e-17, 1e-15, -1e-15] {
+                    for g in [0.0, 1e-16, -1e-16, 1e-12, -1e-12, 1e-8, -1e-8] {
+                        // (x - r)^3 + d (x - r) + g, times lead.
+                        let c = [
+                            lead * (-r * r * r - d * r + g),
+                            lead * (3.0 * r * r + d),
+                            lead * (-3.0 * r),
+                            lead,
+                        ];
+                        let (lo, hi) = (r - 1.0, r + 1.0);
+                        let fast = cubic_roots_in(&c, lo, hi);
+                        let slow = roots_in(&c, lo, hi);
+                        assert_eq!(fast.len(), slow.len(), "{c:?}: {fast:?} vs {slow:?}");
+                        for (f, s) in fast.iter().zip(&slow) {
+                            assert!((f.x - s.x).abs() <= 1e-6, "{c:?}: {fast:?} vs {slow:?}");
+                        }
+                        cases += 1;
+                    }
+                }
+            }
+        }
+        assert_eq!(cases, 210);
     }
 
     /// An empty, reversed or not-a-number interval goes to the general routine: the same
