@@ -189,6 +189,14 @@ fn a_tip_moved_beyond_its_limit_is_found_with_its_error() {
         if expect {
             assert_eq!(tip.len(), 1, "{found:?}");
             assert_eq!(tip[0].row, "10");
+            // The detail gives fk tip - intended: the move reversed.
+            if scale == 2.0 {
+                assert!(
+                    tip[0].detail.contains("= (-0.0060, 0.0080, "),
+                    "{}",
+                    tip[0].detail
+                );
+            }
             // The row's own fk tip is within rounding of the clean path's (the clean run finds
             // nothing): the error is the move.
             assert!(
@@ -292,6 +300,18 @@ fn strokes_and_the_tilting_range_are_found_with_their_ends() {
     assert_eq!(lim[0].row, (k + 1).to_string());
     assert!((lim[0].value - top).abs() < 1e-9 && (lim[0].limit - end).abs() < 1e-9);
     assert!((lim[0].severity - (1.0 + top - end)).abs() < 1e-9);
+    // theta1 below its range: the lower end is the limit.
+    let (k, low, next) = extreme(&theta1, false);
+    let start = 0.5 * (low + next);
+    let (_, found) = run_clean(
+        &machine(&format!("theta1_min = {start}")),
+        &Thresholds::default(),
+    );
+    let lim = of(&found, Check::Limits);
+    assert_eq!(lim.len(), 1, "{found:?}");
+    assert_eq!(lim[0].row, (k + 1).to_string());
+    assert!((lim[0].value - low).abs() < 1e-9 && (lim[0].limit - start).abs() < 1e-9);
+    assert!((lim[0].severity - (1.0 + start - low)).abs() < 1e-9);
 }
 
 #[test]
