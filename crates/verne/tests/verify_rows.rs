@@ -468,3 +468,40 @@ fn joints_that_cannot_be_assembled_a_bad_row_and_a_missing_id_are_findings() {
     );
     assert_eq!(found.len(), 4, "{found:?}");
 }
+
+/// A value exactly at its limit is within it: the largest tip error of the clean rows as the
+/// tip limit, and the smallest amplification factor as its floor, find nothing; a limit one
+/// step (ulp) inside finds that row.
+#[test]
+fn a_value_exactly_at_its_limit_is_within_it() {
+    let m = Machine::default_verne();
+    let worst_of = |th: &Thresholds, check: Check| -> Violation {
+        let (summary, found) = run_clean(&m, th);
+        assert!(found.is_empty(), "{found:?}");
+        let (_, stats) = summary.checks.iter().find(|(c, _)| *c == check).unwrap();
+        stats.worst.clone().unwrap()
+    };
+    // The tip: exceeds(value, limit) is value > limit.
+    let tip = worst_of(&Thresholds::default(), Check::TipError).value;
+    let mut th = Thresholds::default();
+    th.set("tip_error_mm", tip).unwrap();
+    assert!(run_clean(&m, &th).1.is_empty());
+    th.set("tip_error_mm", tip.next_down()).unwrap();
+    let found = run_clean(&m, &th).1;
+    assert_eq!(of(&found, Check::TipError).len(), 1, "{found:?}");
+    // The smallest factor: below(value, limit) is value < limit. Its observation is the worst
+    // singularity one when the other two limits are far away.
+    let mut th = Thresholds::default();
+    th.set("lambda_max", 1e9).unwrap();
+    th.set("parallel_margin_min", 1e-12).unwrap();
+    let smallest = worst_of(&th, Check::Singularity);
+    assert!(
+        smallest.detail.contains("smallest amplification factor"),
+        "{smallest:?}"
+    );
+    th.set("lambda_min", smallest.value).unwrap();
+    assert!(run_clean(&m, &th).1.is_empty());
+    th.set("lambda_min", smallest.value.next_up()).unwrap();
+    let found = run_clean(&m, &th).1;
+    assert!(!of(&found, Check::Singularity).is_empty(), "{found:?}");
+}
