@@ -73,7 +73,6 @@ fn with_key(spec: &GliderSpec, key: &str, value: f64) -> Result<GliderSpec, Vern
 /// Runs the sweep: every glider is built (and checked) first, then one workspace each, a row
 /// each to `output` (stdout when `None`), a progress line each on stderr; `plot` draws the area
 /// and S against the first key. Exit 1 when a workspace of the sweep is empty.
-#[allow(clippy::too_many_arguments)]
 pub fn workspace_sweep(
     spec: &GliderSpec,
     sweeps: &[(String, f64, f64, usize)],
