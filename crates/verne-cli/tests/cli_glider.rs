@@ -736,27 +736,16 @@ fn glider_sweep_rows_are_the_workspaces_of_those_gliders() {
             let rest = &line[line.find(after).unwrap() + after.len()..];
             rest.split([' ', ';', ',', ')']).next().unwrap().to_string()
         };
-        assert_eq!(
-            row[col("region_area")],
-            number_after("t-connected region", "area ")
-        );
-        assert_eq!(
-            row[col("area_lo")],
-            number_after("t-connected region", "between ")
-        );
-        assert_eq!(
-            row[col("area_hi")],
-            number_after("t-connected region", " and ")
-        );
-        assert_eq!(
-            row[col("sampled_area")],
-            number_after("t-connected region", "sampled ")
-        );
-        assert_eq!(row[col("s_area")], number_after("largest rectangle", " = "));
-        assert_eq!(
-            row[col("square_area")],
-            number_after("largest square", " = ")
-        );
+        for (column, line, after) in [
+            ("region_area", "t-connected region", "area "),
+            ("area_lo", "t-connected region", "between "),
+            ("area_hi", "t-connected region", " and "),
+            ("sampled_area", "t-connected region", "sampled "),
+            ("s_area", "largest rectangle", " = "),
+            ("square_area", "largest square", " = "),
+        ] {
+            assert_eq!(row[col(column)], number_after(line, after), "{column}");
+        }
     }
     let picture = std::fs::read_to_string(&svg).unwrap();
     assert!(picture.contains("t-connected region") && picture.contains("S, largest rectangle"));

@@ -257,63 +257,41 @@ fn strokes_and_the_tilting_range_are_found_with_their_ends() {
     let rho1: Vec<f64> = joints.iter().map(|q| q.rho.x).collect();
     let rho3: Vec<f64> = joints.iter().map(|q| q.rho.z).collect();
     let theta1: Vec<f64> = joints.iter().map(|q| q.theta1.to_degrees()).collect();
-    // rho1 above a stroke end set between its largest and next value: that row only.
-    let (k, top, next) = extreme(&rho1, true);
-    let end = 0.5 * (top + next);
-    let (_, found) = run_clean(
-        &machine(&format!("rho1_max = {end}")),
-        &Thresholds::default(),
-    );
-    let lim = of(&found, Check::Limits);
-    assert_eq!(lim.len(), 1, "{found:?}");
-    assert_eq!(lim[0].row, (k + 1).to_string());
-    assert_eq!((lim[0].value, lim[0].limit), (top, end));
-    assert!((lim[0].severity - (1.0 + top - end)).abs() < 1e-9);
-    assert!(
-        lim[0].detail.contains("rho1") && lim[0].detail.contains("above"),
-        "{}",
-        lim[0].detail
-    );
-    // rho3 below a stroke start.
-    let (k, low, next) = extreme(&rho3, false);
-    let start = 0.5 * (low + next);
-    let (_, found) = run_clean(
-        &machine(&format!("rho3_min = {start}")),
-        &Thresholds::default(),
-    );
-    let lim = of(&found, Check::Limits);
-    assert_eq!(lim.len(), 1, "{found:?}");
-    assert_eq!(lim[0].row, (k + 1).to_string());
-    assert_eq!((lim[0].value, lim[0].limit), (low, start));
-    assert!(
-        lim[0].detail.contains("rho3") && lim[0].detail.contains("below"),
-        "{}",
-        lim[0].detail
-    );
-    // theta1 above its range (degrees in the finding).
-    let (k, top, next) = extreme(&theta1, true);
-    let end = 0.5 * (top + next);
-    let (_, found) = run_clean(
-        &machine(&format!("theta1_max = {end}")),
-        &Thresholds::default(),
-    );
-    let lim = of(&found, Check::Limits);
-    assert_eq!(lim.len(), 1, "{found:?}");
-    assert_eq!(lim[0].row, (k + 1).to_string());
-    assert!((lim[0].value - top).abs() < 1e-9 && (lim[0].limit - end).abs() < 1e-9);
-    assert!((lim[0].severity - (1.0 + top - end)).abs() < 1e-9);
-    // theta1 below its range: the lower end is the limit.
-    let (k, low, next) = extreme(&theta1, false);
-    let start = 0.5 * (low + next);
-    let (_, found) = run_clean(
-        &machine(&format!("theta1_min = {start}")),
-        &Thresholds::default(),
-    );
-    let lim = of(&found, Check::Limits);
-    assert_eq!(lim.len(), 1, "{found:?}");
-    assert_eq!(lim[0].row, (k + 1).to_string());
-    assert!((lim[0].value - low).abs() < 1e-9 && (lim[0].limit - start).abs() < 1e-9);
-    assert!((lim[0].severity - (1.0 + start - low)).abs() < 1e-9);
+    // A limit set between a joint's most extreme value and the next: that row only, with the
+    // value (mm, or degrees for theta1), the limit, the severity and the side. The strokes are
+    // compared exactly; theta1 goes through degrees and back.
+    for (values, largest, key, words, exact) in [
+        (&rho1, true, "rho1_max", ["rho1", "above"], true),
+        (&rho3, false, "rho3_min", ["rho3", "below"], true),
+        (&theta1, true, "theta1_max", ["theta1", "outside"], false),
+        (&theta1, false, "theta1_min", ["theta1", "outside"], false),
+    ] {
+        let (k, extreme_value, next) = extreme(values, largest);
+        let limit = 0.5 * (extreme_value + next);
+        let (_, found) = run_clean(
+            &machine(&format!("{key} = {limit}")),
+            &Thresholds::default(),
+        );
+        let lim = of(&found, Check::Limits);
+        assert_eq!(lim.len(), 1, "{key}: {found:?}");
+        let v = lim[0];
+        assert_eq!(v.row, (k + 1).to_string(), "{key}");
+        if exact {
+            assert_eq!((v.value, v.limit), (extreme_value, limit), "{key}");
+        } else {
+            assert!((v.value - extreme_value).abs() < 1e-9, "{key}: {v:?}");
+            assert!((v.limit - limit).abs() < 1e-9, "{key}: {v:?}");
+        }
+        assert!(
+            (v.severity - (1.0 + (extreme_value - limit).abs())).abs() < 1e-9,
+            "{key}"
+        );
+        assert!(
+            words.iter().all(|w| v.detail.contains(w)),
+            "{key}: {}",
+            v.detail
+        );
+    }
 }
 
 #[test]

@@ -374,55 +374,23 @@ mod tests {
     #[test]
     fn workspace_step_sets_the_grid_and_bad_arguments_are_refused() {
         let spec = GliderSpec::preset("biglide2").unwrap();
-        let ok = workspace(
-            &spec,
-            GridSize::Step(0.05),
-            None,
-            Sampling::Auto,
-            None,
-            None,
-            Units::default(),
-        );
-        assert_eq!(ok.unwrap(), EXIT_OK);
-        let few = workspace(
-            &spec,
-            GridSize::Nodes(1),
-            None,
-            Sampling::Auto,
-            None,
-            None,
-            Units::default(),
-        );
-        assert!(few.unwrap_err().to_string().contains("expected 2 to"));
-        let tiny = workspace(
-            &spec,
-            GridSize::Step(1e-9),
-            None,
-            Sampling::Auto,
-            None,
-            None,
-            Units::default(),
-        );
-        assert!(tiny.unwrap_err().to_string().contains("larger step"));
-        let gif = workspace(
-            &spec,
-            GridSize::Nodes(11),
-            None,
-            Sampling::Auto,
-            None,
-            Some(Path::new("w.gif")),
-            Units::default(),
-        );
-        assert!(gif.unwrap_err().to_string().contains(".svg or .png"));
-        let bounds = workspace(
-            &spec,
-            GridSize::Nodes(11),
-            Some([3.0, 1.0]),
-            Sampling::Auto,
-            None,
-            None,
-            Units::default(),
-        );
-        assert!(bounds.is_err());
+        let call = |size, lambda, plot: Option<&Path>| {
+            workspace(
+                &spec,
+                size,
+                lambda,
+                Sampling::Auto,
+                None,
+                plot,
+                Units::default(),
+            )
+        };
+        assert_eq!(call(GridSize::Step(0.05), None, None).unwrap(), EXIT_OK);
+        let error = |size, lambda, plot| call(size, lambda, plot).unwrap_err().to_string();
+        assert!(error(GridSize::Nodes(1), None, None).contains("expected 2 to"));
+        assert!(error(GridSize::Step(1e-9), None, None).contains("larger step"));
+        let gif = error(GridSize::Nodes(11), None, Some(Path::new("w.gif")));
+        assert!(gif.contains(".svg or .png"));
+        assert!(error(GridSize::Nodes(11), Some([3.0, 1.0]), None).contains("0 < LO < HI"));
     }
 }
