@@ -1,0 +1,147 @@
+//! What the in-memory tests of `verne::verify` share (`verify_rows.rs`, `verify_segments.rs`):
+//! the first rows of data/verify as joints and path points, sources that hold rows in memory,
+//! and a run that collects the findings. Each test file uses part of it.
+#![allow(dead_code)]
+
+use std::collections::VecDeque;
+
+use nalgebra::Vector3;
+use verne::spec::Machine;
+use verne::verify::{
+    Check, Item, JointSource, Joints, PairingError, PathPoint, RowSource, Summary, Thresholds,
+    VerifyOptions, Violation, verify,
+};
+
+/// Rows of data/verify read here.
+pub const ROWS: usize = 30;
+
+#[derive(Debug)]
+pub struct Fail(pub String);
+
+impl From<PairingError> for Fail {
+    fn from(e: PairingError) -> Fail {
+        Fail(format!("{e:?}"))
+    }
+}
+
+/// Rows held in memory.
+pub struct Rows<T> {
+    pub name: &'static str,
+    pub items: VecDeque<Item<T>>,
+}
+
+impl<T> RowSource for Rows<T> {
+    type Row = T;
+    type Error = Fail;
+    fn name(&self) -> &str {
+        self.name
+    }
+    fn has_id(&self) -> bool {
+        true
+    }
+    fn next_item(&mut self) -> Result<Option<Item<T>>, Fail> {
+        Ok(self.items.pop_front())
+    }
+}
+
+impl JointSource for Rows<Joints> {
+    fn timed(&self) -> bool {
+        true
+    }
+}
+
+/// The first `ROWS` data rows of a CSV of data/verify, as numbers (the id column first).
+pub fn table(file: &str) -> Vec<Vec<f64>> {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/verify/");
+    let text = std::fs::read_to_string(format!("{path}{file}")).unwrap();
+    text.lines()
+        .skip(1)
+        .take(ROWS)
+        .map(|l| l.split(',').map(|c| c.trim().parse().unwrap()).collect())
+        .collect()
+}
+
+pub fn item<T>(k: usize, value: Result<T, String>) -> Item<T> {
+    Item {
+        index: k as u64 + 1,
+        line: k as u64 + 2,
+        id: Some((k + 1).to_string()),
+        value,
+    }
+}
+
+/// The clean inputs: joints (id, t, rho1..3, theta1, theta2 in degrees) and path (id, tip,
+/// axis).
+pub fn clean() -> (Vec<Joints>, Vec<PathPoint>) {
+    let joints = table("joints.csv")
+        .iter()
+        .map(|r| Joints {
+            rho: Vector3::new(r[2], r[3], r[4]),
+            theta1: r[5].to_radians(),
+            theta2: r[6].to_radians(),
+            t: Some(r[1]),
+            feed: None,
+            duration: None,
+            rapid: false,
+        })
+        .collect();
+    let path = table("path.csv")
+        .iter()
+        .map(|r| {
+            PathPoint::new(
+                Vector3::new(r[1], r[2], r[3]),
+                Vector3::new(r[4], r[5], r[6]),
+            )
+        })
+        .collect();
+    (joints, path)
+}
+
+/// Runs verify on the rows (a joint row replaced by an error where `joints` holds one).
+pub fn run(
+    m: &Machine,
+    th: &Thresholds,
+    joints: Vec<Result<Joints, String>>,
+    path: Vec<PathPoint>,
+) -> (Summary, Vec<Violation>) {
+    let opt = VerifyOptions {
+        thresholds: *th,
+        tool_length: m.tool_length,
+    };
+    let mut j = Rows {
+        name: "joints",
+        items: joints
+            .into_iter()
+            .enumerate()
+            .map(|(k, v)| item(k, v))
+            .collect(),
+    };
+    let mut p = Rows {
+        name: "path",
+        items: path
+            .into_iter()
+            .enumerate()
+            .map(|(k, v)| item(k, Ok(v)))
+            .collect(),
+    };
+    let mut found = Vec::new();
+    let summary = verify(m, &opt, &mut j, &mut p, &mut |v: &Violation| {
+        found.push(v.clone());
+        Ok::<(), Fail>(())
+    })
+    .unwrap_or_else(|Fail(e)| panic!("{e}"));
+    (summary, found)
+}
+
+pub fn run_clean(m: &Machine, th: &Thresholds) -> (Summary, Vec<Violation>) {
+    let (joints, path) = clean();
+    run(m, th, joints.into_iter().map(Ok).collect(), path)
+}
+
+pub fn of(found: &[Violation], check: Check) -> Vec<&Violation> {
+    found.iter().filter(|v| v.check == check).collect()
+}
+
+pub fn machine(limits: &str) -> Machine {
+    Machine::from_toml_str(&format!("base = \"verne\"\n[limits]\n{limits}\n"), "test").unwrap()
+}

@@ -1,0 +1,642 @@
+//! `verne::verify`'s segment checks through the library, without the CLI (as `verify_rows.rs`
+//! does for the row checks): the first rows of data/verify and paths built with the library's
+//! inverse kinematics, each changed to break one segment check by a known amount; every
+//! finding's check, row, value and limit asserted against a value computed here, and a limit
+//! one step away asserted to find nothing. Segment findings are placed on the row that ends the
+//! segment (1-based). So `cargo mutants -f crates/verne/src/verify/segment.rs` measures the
+//! segment checks with the core crate's tests.
+
+mod verify_data;
+
+use std::f64::consts::PI;
+
+use nalgebra::Vector3;
+use verify_data::*;
+use verne::machine::orientation::{AxisAngles, ToolOrientation, axis_angles};
+use verne::machine::{FirstRowChoice, PathState, ToolPose, machine_fk, machine_ik};
+use verne::parallel_module::branches::WORKING_CONFIG;
+use verne::parallel_module::equations::{ModulePose, Sliders, polish_pose};
+use verne::parallel_module::fk;
+use verne::parallel_module::ik::wrap_angle;
+use verne::parallel_module::kinetostatics::kinetostatics;
+use verne::spec::Machine;
+use verne::verify::{Check, JOINT_NAMES, Joints, PathPoint, Thresholds, Violation};
+
+fn oks(joints: &[Joints]) -> Vec<Result<Joints, String>> {
+    joints.iter().copied().map(Ok).collect()
+}
+
+fn thresholds(set: &[(&str, f64)]) -> Thresholds {
+    let mut th = Thresholds::default();
+    for (name, value) in set {
+        th.set(name, *value).unwrap();
+    }
+    th
+}
+
+/// A joint's value as verify compares it: mm for the sliders, degrees for the table's axes.
+fn shown(i: usize, rad_or_mm: f64) -> f64 {
+    if i < 3 {
+        rad_or_mm
+    } else {
+        rad_or_mm.to_degrees()
+    }
+}
+
+/// The changes of joint `i` along the segments (k: the segment from row k to row k + 1,
+/// 0-based), signed, in mm or rad.
+fn change(joints: &[Joints], i: usize) -> Vec<f64> {
+    let get = |q: &Joints| [q.rho.x, q.rho.y, q.rho.z, q.theta1, q.theta2][i];
+    joints.windows(2).map(|w| get(&w[1]) - get(&w[0])).collect()
+}
+
+/// The two largest of (segment, joint, value) over the joints `group`: a limit between them
+/// is broken by exactly one joint of one segment.
+fn two_largest(
+    per_segment: impl Fn(usize) -> Vec<f64>,
+    group: &[usize],
+) -> [(usize, usize, f64); 2] {
+    let mut all: Vec<(usize, usize, f64)> = group
+        .iter()
+        .flat_map(|&i| {
+            per_segment(i)
+                .into_iter()
+                .enumerate()
+                .map(move |(k, v)| (k, i, v))
+        })
+        .collect();
+    all.sort_by(|a, b| b.2.total_cmp(&a.2));
+    assert!(all[0].2 > all[1].2, "{:?}", &all[..2]);
+    [all[0], all[1]]
+}
+
+/// The joint groups of the step and speed thresholds (one threshold for the three sliders).
+const GROUPS: [&[usize]; 3] = [&[0, 1, 2], &[3], &[4]];
+
+#[test]
+fn the_largest_joint_change_is_a_jump_above_its_limit() {
+    let m = Machine::default_verne();
+    let (joints, path) = clean();
+    for (group, name) in GROUPS
+        .iter()
+        .zip(["rho_step_mm", "theta1_step_deg", "theta2_step_deg"])
+    {
+        let per_segment = |i: usize| -> Vec<f64> {
+            change(&joints, i)
+                .iter()
+                .map(|d| shown(i, d.abs()))
+                .collect()
+        };
+        let [(k, i, top), (_, _, next)] = two_largest(per_segment, group);
+        let limit = 0.5 * (top + next);
+        // The slider speeds are limited to nothing too: every segment is a velocity finding
+        // but the one that jumped (a jump ends the segment's checks).
+        let th = thresholds(&[(name, limit), ("rho_velocity_mm_s", 1e-9)]);
+        let (_, found) = run(&m, &th, oks(&joints), path.clone());
+        let jumps = of(&found, Check::JointJump);
+        assert_eq!(jumps.len(), 1, "{name}: {jumps:?}");
+        let v = jumps[0];
+        assert_eq!(v.row, (k + 2).to_string(), "{name}");
+        assert!(
+            (v.value - top).abs() <= 1e-12 * top,
+            "{name}: {v:?} vs {top}"
+        );
+        assert!((v.limit - limit).abs() <= 1e-12 * limit, "{name}: {v:?}");
+        let signed = shown(i, change(&joints, i)[k]);
+        assert!(
+            v.detail
+                .contains(&format!("{} changes by {signed:+.4}", JOINT_NAMES[i])),
+            "{name}: {}",
+            v.detail
+        );
+        let velocity_rows: Vec<&str> = of(&found, Check::Velocity)
+            .iter()
+            .map(|v| v.row.as_str())
+            .collect();
+        assert!(!velocity_rows.contains(&v.row.as_str()), "{name}");
+        for r in 2..=ROWS {
+            assert!(
+                r == k + 2 || velocity_rows.contains(&r.to_string().as_str()),
+                "{name}: row {r}"
+            );
+        }
+        // The limit at the largest change: nothing.
+        let th = thresholds(&[(name, top)]);
+        assert!(
+            of(
+                &run(&m, &th, oks(&joints), path.clone()).1,
+                Check::JointJump
+            )
+            .is_empty()
+        );
+        // A rapid move to the segment's end row (said by the path or by the joints): no jump.
+        let th = thresholds(&[(name, limit)]);
+        let mut rapid_path = path.clone();
+        rapid_path[k + 1].rapid = true;
+        assert!(of(&run(&m, &th, oks(&joints), rapid_path).1, Check::JointJump).is_empty());
+        let mut rapid_joints = joints.clone();
+        rapid_joints[k + 1].rapid = true;
+        assert!(
+            of(
+                &run(&m, &th, oks(&rapid_joints), path.clone()).1,
+                Check::JointJump
+            )
+            .is_empty()
+        );
+    }
+}
+
+/// Each joint's speed on each segment from the table's `t`, in mm/s or deg/s.
+fn speeds(joints: &[Joints], i: usize) -> Vec<f64> {
+    change(joints, i)
+        .iter()
+        .zip(joints.windows(2))
+        .map(|(d, w)| shown(i, (d / (w[1].t.unwrap() - w[0].t.unwrap())).abs()))
+        .collect()
+}
+
+#[test]
+fn the_fastest_joint_is_a_velocity_finding_above_its_limit() {
+    let m = Machine::default_verne();
+    let (joints, path) = clean();
+    for (group, name) in GROUPS.iter().zip([
+        "rho_velocity_mm_s",
+        "theta1_velocity_deg_s",
+        "theta2_velocity_deg_s",
+    ]) {
+        let [(k, i, top), (_, _, next)] = two_largest(|i| speeds(&joints, i), group);
+        let limit = 0.5 * (top + next);
+        let (_, found) = run(
+            &m,
+            &thresholds(&[(name, limit)]),
+            oks(&joints),
+            path.clone(),
+        );
+        let fast = of(&found, Check::Velocity);
+        assert_eq!(fast.len(), 1, "{name}: {found:?}");
+        let v = fast[0];
+        assert_eq!(v.row, (k + 2).to_string(), "{name}");
+        assert!(
+            (v.value - top).abs() <= 1e-12 * top,
+            "{name}: {v:?} vs {top}"
+        );
+        assert!((v.limit - limit).abs() <= 1e-12 * limit, "{name}: {v:?}");
+        let dt = joints[k + 1].t.unwrap() - joints[k].t.unwrap();
+        assert!(
+            v.detail.contains(JOINT_NAMES[i]) && v.detail.contains(&format!("(dt = {dt:.6} s)")),
+            "{name}: {}",
+            v.detail
+        );
+        let (_, found) = run(&m, &thresholds(&[(name, top)]), oks(&joints), path.clone());
+        assert!(of(&found, Check::Velocity).is_empty(), "{name}: {found:?}");
+    }
+}
+
+#[test]
+fn a_time_that_does_not_increase_is_a_velocity_finding() {
+    let m = Machine::default_verne();
+    let (mut joints, path) = clean();
+    // Row 11 at row 10's time, row 21 0.01 s before row 20's.
+    joints[10].t = joints[9].t;
+    joints[20].t = Some(joints[19].t.unwrap() - 0.01);
+    let (_, found) = run(&m, &Thresholds::default(), oks(&joints), path);
+    let v = of(&found, Check::Velocity);
+    assert_eq!(v.len(), 2, "{found:?}");
+    assert_eq!((v[0].row.as_str(), v[0].value), ("11", 0.0));
+    assert!(
+        v[0].detail.contains("t does not increase (dt = 0 s)"),
+        "{}",
+        v[0].detail
+    );
+    assert_eq!(v[1].row, "21");
+    assert!((v[1].value + 0.01).abs() < 1e-12, "{:?}", v[1]);
+    assert!(v[0].limit.is_nan() && v[1].limit.is_nan());
+}
+
+/// The time of a segment when the joint table has no `t`: the joints' own duration, else the
+/// path's, else the path's length over its feed; none for a rapid move or a feed that is not
+/// positive.
+#[test]
+fn without_t_the_segment_time_comes_from_durations_then_the_feed() {
+    let m = Machine::default_verne();
+    let (mut joints, mut path) = clean();
+    for q in &mut joints {
+        q.t = None;
+    }
+    let rho_speed = |found: &[Violation]| -> Vec<(String, f64)> {
+        of(found, Check::Velocity)
+            .iter()
+            .map(|v| (v.row.clone(), v.value))
+            .collect()
+    };
+    // A feed on the path: dt = |tip_b - tip_a| / feed. The fastest slider of the clean run at
+    // that time, then a limit just under it.
+    let feed = 10.0;
+    for p in &mut path {
+        p.feed = Some(feed);
+    }
+    let dt: Vec<f64> = path
+        .windows(2)
+        .map(|w| (w[1].tip - w[0].tip).norm() / feed)
+        .collect();
+    let per_segment = |i: usize| -> Vec<f64> {
+        change(&joints, i)
+            .iter()
+            .zip(&dt)
+            .map(|(d, t)| (d / t).abs())
+            .collect()
+    };
+    let [(k, _, top), (_, _, next)] = two_largest(per_segment, GROUPS[0]);
+    let th = thresholds(&[("rho_velocity_mm_s", 0.5 * (top + next))]);
+    let found = run(&m, &th, oks(&joints), path.clone()).1;
+    let v = rho_speed(&found);
+    assert_eq!(v.len(), 1, "{found:?}");
+    assert_eq!(v[0].0, (k + 2).to_string());
+    assert!((v[0].1 - top).abs() <= 1e-9 * top, "{v:?} vs {top}");
+    // A feed that is zero or negative gives no time.
+    for bad in [0.0, -10.0] {
+        let mut p = path.clone();
+        p[k + 1].feed = Some(bad);
+        assert!(
+            rho_speed(&run(&m, &th, oks(&joints), p).1).is_empty(),
+            "{bad}"
+        );
+    }
+    // Durations come before the feed: the joints' (0.5 s: too slow to break the limit) before
+    // the path's (1e-4 s: far too fast).
+    let mut p = path.clone();
+    p[k + 1].duration = Some(1e-4);
+    let found = run(&m, &th, oks(&joints), p.clone()).1;
+    assert!(
+        rho_speed(&found)
+            .iter()
+            .any(|(r, _)| *r == (k + 2).to_string())
+    );
+    let mut q = joints.clone();
+    q[k + 1].duration = Some(0.5);
+    let found = run(&m, &th, oks(&q), p.clone()).1;
+    assert!(rho_speed(&found).is_empty(), "{found:?}");
+    // A rapid move has no programmed time: none of them counts.
+    q[k + 1].duration = Some(1e-4);
+    p[k + 1].rapid = true;
+    let found = run(&m, &th, oks(&q), p).1;
+    assert!(rho_speed(&found).is_empty(), "{found:?}");
+}
+
+/// The tool tip at the joints' midpoint, in the machine's assembly mode nearest `near`.
+fn midpoint_tip(m: &Machine, a: &Joints, b: &Joints, near: &Vector3<f64>) -> Vector3<f64> {
+    let rho = a.rho + (b.rho - a.rho) * 0.5;
+    let q1 = a.theta1 + (b.theta1 - a.theta1) * 0.5;
+    let q2 = a.theta2 + (b.theta2 - a.theta2) * 0.5;
+    machine_fk(m, &rho, q1, q2, m.tool_length)
+        .iter()
+        .filter(|md| md.config == WORKING_CONFIG)
+        .map(|md| md.tool.tip)
+        .min_by(|x, y| (x - near).norm().total_cmp(&(y - near).norm()))
+        .unwrap()
+}
+
+#[test]
+fn the_chordal_error_is_the_midpoint_tip_off_the_line() {
+    let m = Machine::default_verne();
+    let (joints, path) = clean();
+    let chords: Vec<f64> = (0..ROWS - 1)
+        .map(|k| {
+            let mid = (path[k].tip + path[k + 1].tip) * 0.5;
+            (midpoint_tip(&m, &joints[k], &joints[k + 1], &mid) - mid).norm()
+        })
+        .collect();
+    // A limit of next to nothing: every segment, with its chord.
+    let tiny = 1e-300;
+    let (_, found) = run(
+        &m,
+        &thresholds(&[("chord_error_mm", tiny)]),
+        oks(&joints),
+        path.clone(),
+    );
+    let found = of(&found, Check::ChordError);
+    assert_eq!(found.len(), ROWS - 1, "{found:?}");
+    for (v, chord) in found.iter().zip(&chords) {
+        assert!((v.value - chord).abs() < 1e-9, "{v:?} vs {chord}");
+        assert_eq!(v.limit, tiny);
+    }
+    // The largest chord as the limit: nothing; one ulp under it: that segment.
+    let (k, _) = chords
+        .iter()
+        .copied()
+        .enumerate()
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .unwrap();
+    let top = found[k].value;
+    assert!(top > 1e-6, "{top}");
+    let th = thresholds(&[("chord_error_mm", top)]);
+    assert!(
+        of(
+            &run(&m, &th, oks(&joints), path.clone()).1,
+            Check::ChordError
+        )
+        .is_empty()
+    );
+    let th = thresholds(&[("chord_error_mm", top.next_down())]);
+    let found = run(&m, &th, oks(&joints), path.clone()).1;
+    let chord = of(&found, Check::ChordError);
+    assert_eq!(chord.len(), 1, "{found:?}");
+    assert_eq!(chord[0].row, (k + 2).to_string());
+    assert!(chord[0].detail.contains("off the intended line"));
+    // A rapid move is not along the line: no chord.
+    let mut rapid = path.clone();
+    rapid[k + 1].rapid = true;
+    assert!(of(&run(&m, &th, oks(&joints), rapid).1, Check::ChordError).is_empty());
+}
+
+/// The joints of row `k` from the other orientation solution of its tool pose, theta2 unwrapped
+/// near the row's.
+fn other_orientation(m: &Machine, q: &Joints, p: &PathPoint) -> Joints {
+    let Ok(AxisAngles::Regular(sols)) = axis_angles(&p.axis) else {
+        panic!("a regular axis expected: {p:?}")
+    };
+    let b = sols
+        .iter()
+        .flat_map(|a| {
+            machine_ik(
+                m,
+                &ToolPose {
+                    tip: p.tip,
+                    phi1: a.phi1,
+                    phi2: a.phi2,
+                },
+                m.tool_length,
+            )
+        })
+        .filter(|b| b.working() && (b.theta1 - q.theta1).abs() > 1e-3)
+        .min_by(|x, y| x.theta1.abs().total_cmp(&y.theta1.abs()))
+        .unwrap();
+    Joints {
+        rho: b.rho,
+        theta1: b.theta1,
+        theta2: q.theta2 + wrap_angle(b.theta2 - q.theta2),
+        ..*q
+    }
+}
+
+#[test]
+fn a_row_in_the_other_orientation_solution_is_a_branch_change_on_both_segments() {
+    let m = Machine::default_verne();
+    let (mut joints, path) = clean();
+    let k = 14;
+    let other = other_orientation(&m, &joints[k], &path[k]);
+    assert!(other.theta1 * joints[k].theta1 < 0.0, "{other:?}");
+    let turns = [
+        wrap_angle(other.theta2 - joints[k - 1].theta2),
+        wrap_angle(joints[k + 1].theta2 - other.theta2),
+    ];
+    joints[k] = other;
+    let (_, found) = run(&m, &Thresholds::default(), oks(&joints), path);
+    let branch = of(&found, Check::Branch);
+    assert_eq!(branch.len(), 2, "{found:?}");
+    // The two segments change solution one way and back (which is 1 depends on phi1's sign).
+    let way = if branch[0].detail.contains("orientation solution 1 -> 2") {
+        ["1 -> 2", "2 -> 1"]
+    } else {
+        ["2 -> 1", "1 -> 2"]
+    };
+    for (j, v) in branch.iter().enumerate() {
+        assert_eq!(v.row, (k + 1 + j).to_string(), "{v:?}");
+        assert!(
+            v.detail
+                .contains(&format!("orientation solution {}", way[j])),
+            "{}",
+            v.detail
+        );
+        assert!(
+            (v.value - turns[j].abs().to_degrees()).abs() < 1e-9,
+            "{v:?} vs {}",
+            turns[j]
+        );
+        assert_eq!(v.limit, 90.0);
+    }
+    // A branch change ends the segment's checks: no jump of theta2 (half a turn) reported.
+    assert!(of(&found, Check::JointJump).is_empty(), "{found:?}");
+}
+
+/// A pass whose tool axis crosses the table normal between rows 30 and 31 (gamma from 14.75
+/// to -14.75 deg in 0.5 deg steps), the joints of the first orientation solution nearest the
+/// previous row, theta2 unwrapped: theta2 turns by half a turn between those rows.
+fn through_the_normal(m: &Machine) -> (Vec<Joints>, Vec<PathPoint>) {
+    let mut joints: Vec<Joints> = Vec::new();
+    let mut path = Vec::new();
+    for k in 0..60 {
+        let gamma = (14.75 - 0.5 * k as f64).to_radians();
+        let tip = Vector3::new(-15.0 + 0.5 * k as f64, 10.0, 40.0);
+        let axis = Vector3::new(gamma.sin(), 0.0, gamma.cos());
+        let Ok(AxisAngles::Regular(sols)) = axis_angles(&axis) else {
+            panic!("a regular axis expected")
+        };
+        let prev = joints.last().copied();
+        let pose = ToolPose {
+            tip,
+            phi1: sols[0].phi1,
+            phi2: sols[0].phi2,
+        };
+        let b = machine_ik(m, &pose, m.tool_length)
+            .into_iter()
+            .filter(|b| b.working())
+            .min_by(|x, y| {
+                let d = |t: f64| prev.map_or(t.abs(), |p| (t - p.theta1).abs());
+                d(x.theta1).total_cmp(&d(y.theta1))
+            })
+            .unwrap();
+        joints.push(Joints {
+            rho: b.rho,
+            theta1: b.theta1,
+            theta2: prev.map_or(b.theta2, |p| p.theta2 + wrap_angle(b.theta2 - p.theta2)),
+            t: None,
+            feed: None,
+            duration: None,
+            rapid: false,
+        });
+        path.push(PathPoint::new(tip, axis));
+    }
+    (joints, path)
+}
+
+#[test]
+fn half_a_turn_of_theta2_through_the_table_normal_is_a_flip() {
+    let m = Machine::default_verne();
+    let (joints, path) = through_the_normal(&m);
+    let turn = joints[30].theta2 - joints[29].theta2;
+    assert!((turn.abs() - PI).abs() < 1e-9, "{turn}");
+    // The flip, and the same with a whole turn more from row 31 on (the turn is taken modulo
+    // a full turn).
+    for extra in [0.0, 2.0 * PI] {
+        let mut q = joints.clone();
+        for j in &mut q[30..] {
+            j.theta2 += extra.copysign(turn);
+        }
+        let (_, found) = run(&m, &Thresholds::default(), oks(&q), path.clone());
+        assert_eq!(found.len(), 1, "{found:?}");
+        let v = &found[0];
+        assert_eq!((v.check, v.row.as_str()), (Check::Theta2Flip, "31"));
+        let expect = (turn.abs() + extra).to_degrees();
+        assert!((v.value - expect).abs() < 1e-9, "{v:?} vs {expect}");
+        assert_eq!(
+            v.limit,
+            Thresholds::default().get(verne::verify::Th::Theta2StepDeg)
+        );
+    }
+    // Row 31's theta2 turned back by 3 deg (its tip and axis moved: the tip, axis and chord
+    // limits relaxed), so that the turn is 3 deg short of half a turn: the flip tolerance just
+    // above 3 deg finds a flip; just under it, a joint jump of theta2.
+    let mut q = joints.clone();
+    q[30].theta2 -= 3f64.to_radians().copysign(turn);
+    for (tol, check) in [(3.03, Check::Theta2Flip), (2.97, Check::JointJump)] {
+        let th = thresholds(&[
+            ("theta2_flip_tol_deg", tol),
+            ("tip_error_mm", 50.0),
+            ("axis_error_deg", 10.0),
+            ("chord_error_mm", 100.0),
+        ]);
+        let (_, found) = run(&m, &th, oks(&q), path.clone());
+        let at31: Vec<&Violation> = found.iter().filter(|v| v.row == "31").collect();
+        assert_eq!(at31.len(), 1, "{tol}: {found:?}");
+        assert_eq!(at31[0].check, check, "{tol}: {found:?}");
+        assert!((at31[0].value - 177.0).abs() < 1e-9, "{tol}: {found:?}");
+    }
+}
+
+/// Joints with two assembly modes of the machine's kind (the triple of verify_rows.rs): two
+/// rows with these joints whose intended tips are the two modes' tips are each checked in
+/// their own mode, and the segment between them, where the joints do not move, arrives in a
+/// mode other than the end row's.
+#[test]
+fn a_segment_that_arrives_in_another_assembly_mode_is_a_branch_change() {
+    let m = Machine::default_verne();
+    let q = Joints {
+        rho: Vector3::new(993.8134583763522, 36.74643683672117, 373.9948975572779),
+        theta1: 0.1,
+        theta2: 0.2,
+        t: None,
+        feed: None,
+        duration: None,
+        rapid: false,
+    };
+    let modes = machine_fk(&m, &q.rho, q.theta1, q.theta2, m.tool_length);
+    let points: Vec<PathPoint> = modes
+        .iter()
+        .filter(|md| {
+            md.config == WORKING_CONFIG
+                && m.module.r_big1 * md.module.alpha.cos() > m.module.r_small1
+        })
+        .map(|md| PathPoint::new(md.tool.tip, md.axis))
+        .collect();
+    assert_eq!(points.len(), 2);
+    for (a, b, expect) in [(0, 1, true), (1, 0, true), (0, 0, false), (1, 1, false)] {
+        let (_, found) = run(
+            &m,
+            &Thresholds::default(),
+            vec![Ok(q), Ok(q)],
+            vec![points[a], points[b]],
+        );
+        // (Near these joints the rods tilt too far and the module is near a singularity: those
+        // row findings do not stop a segment's checks.)
+        let branch = of(&found, Check::Branch);
+        if expect {
+            assert_eq!(branch.len(), 1, "{a}{b}: {found:?}");
+            let v = branch[0];
+            assert_eq!((v.row.as_str(), v.value), ("2", 1.0));
+            assert!(
+                v.detail.contains("arrive in another assembly mode"),
+                "{}",
+                v.detail
+            );
+        } else {
+            assert!(branch.is_empty(), "{a}{b}: {found:?}");
+        }
+    }
+}
+
+/// The largest velocity amplification factor at sliders `rho`: of the working mode, or of the
+/// pose continued from `start` (as verify tracks a segment).
+fn lambda_max_at(m: &Machine, rho: &Sliders, start: Option<ModulePose>) -> (f64, ModulePose) {
+    let pose = match start {
+        None => fk::working(&fk::solve(m, rho)).unwrap().pose,
+        Some(p) => polish_pose(&m.module, p, rho),
+    };
+    (kinetostatics(&m.module, &pose, rho).amplification[0], pose)
+}
+
+/// A genuinely mid-segment defect (the CLI's tests/verify.rs has the same through the command):
+/// along y_t with a vertical tool, rows 0.5 mm apart, lambda_max peaks between two rows near
+/// y_t = 0. With lambda_max set between the rows' largest value and the value at the midpoint of
+/// the segment holding the peak, only that segment is found, at s = 0.5, with that value.
+#[test]
+fn an_amplification_peak_between_two_rows_is_found_mid_segment() {
+    let m = Machine::default_verne();
+    let mut state = PathState::new(FirstRowChoice::SmallestTheta1);
+    let axis = Vector3::new(0.0, 0.0, 1.0);
+    let (mut joints, mut path) = (Vec::new(), Vec::new());
+    for k in 0..200 {
+        let tip = Vector3::new(0.0, -50.25 + 0.5 * k as f64, 40.0);
+        let r = state
+            .next_row(&m, &tip, &ToolOrientation::Axis(axis), m.tool_length)
+            .unwrap();
+        joints.push(Joints {
+            rho: r.rho,
+            theta1: r.theta1,
+            theta2: r.theta2,
+            t: Some(0.02 * k as f64),
+            feed: None,
+            duration: None,
+            rapid: false,
+        });
+        path.push(PathPoint::new(tip, axis));
+    }
+    let rows: Vec<f64> = joints
+        .iter()
+        .map(|j| lambda_max_at(&m, &j.rho, None).0)
+        .collect();
+    let mids: Vec<f64> = joints
+        .windows(2)
+        .map(|w| {
+            let (_, pa) = lambda_max_at(&m, &w[0].rho, None);
+            lambda_max_at(&m, &(w[0].rho + (w[1].rho - w[0].rho) * 0.5), Some(pa)).0
+        })
+        .collect();
+    // A segment (ending at row e, 0-based) whose midpoint beats both ends and both neighbours.
+    let e = (20..joints.len() - 20)
+        .filter(|&e| {
+            let mid = mids[e - 1];
+            mid > rows[e - 1].max(rows[e]) && mid > mids[e - 2].max(mids[e])
+        })
+        .max_by(|&a, &b| {
+            let excess = |e: usize| mids[e - 1] - rows[e - 1].max(rows[e]);
+            excess(a).total_cmp(&excess(b))
+        })
+        .expect("a local maximum of lambda_max inside a segment");
+    let window = e - 10..e + 11;
+    let top_row = rows[window.clone()].iter().copied().fold(0.0, f64::max);
+    let other_mids = (window.start + 1..window.end)
+        .filter(|&k| k != e)
+        .map(|k| mids[k - 1])
+        .fold(0.0, f64::max);
+    let floor = top_row.max(other_mids);
+    assert!(mids[e - 1] > floor, "{} vs {floor}", mids[e - 1]);
+    let limit = 0.5 * (floor + mids[e - 1]);
+    let (_, found) = run(
+        &m,
+        &thresholds(&[("lambda_max", limit)]),
+        oks(&joints[window.clone()]),
+        path[window].to_vec(),
+    );
+    assert_eq!(found.len(), 1, "{found:?}");
+    let v = &found[0];
+    // Rows are numbered 1.. within the window; the segment ends at window row 11.
+    assert_eq!((v.check, v.row.as_str()), (Check::Singularity, "11"));
+    assert!(v.detail.contains("s = 0.5"), "{}", v.detail);
+    assert!(
+        (v.value - mids[e - 1]).abs() < 1e-9,
+        "{v:?} vs {}",
+        mids[e - 1]
+    );
+    assert_eq!(v.limit, limit);
+}
