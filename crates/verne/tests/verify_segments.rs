@@ -20,7 +20,9 @@ use verne::parallel_module::fk;
 use verne::parallel_module::ik::wrap_angle;
 use verne::parallel_module::kinetostatics::kinetostatics;
 use verne::spec::Machine;
-use verne::verify::{Check, JOINT_NAMES, Joints, PathPoint, Thresholds, Violation};
+use verne::verify::{
+    Check, JOINT_NAMES, Joints, PathPoint, SEGMENT_SAMPLE_MM, Thresholds, Violation,
+};
 
 fn oks(joints: &[Joints]) -> Vec<Result<Joints, String>> {
     joints.iter().copied().map(Ok).collect()
@@ -639,4 +641,64 @@ fn an_amplification_peak_between_two_rows_is_found_mid_segment() {
         mids[e - 1]
     );
     assert_eq!(v.limit, limit);
+}
+
+/// Two slider triples, each with a mode of the machine's kind, found by a scan of random
+/// segments (3 of 55,801): tracked from the first, the module leaves the machine's kind a
+/// little way along the segment.
+#[test]
+fn joints_that_leave_the_machine_s_assembly_mode_mid_segment_are_a_branch_change() {
+    let m = Machine::default_verne();
+    let ends = [
+        Vector3::new(1114.8098962832719, 457.0534324386325, 179.893518392908),
+        Vector3::new(151.5151959394836, -177.48689885838002, 264.4637304372717),
+    ];
+    let joints: Vec<Joints> = ends
+        .iter()
+        .map(|rho| Joints {
+            rho: *rho,
+            theta1: 0.0,
+            theta2: 0.0,
+            t: None,
+            feed: None,
+            duration: None,
+            rapid: false,
+        })
+        .collect();
+    let path: Vec<PathPoint> = joints
+        .iter()
+        .map(|q| {
+            let md = machine_fk(&m, &q.rho, 0.0, 0.0, m.tool_length)
+                .into_iter()
+                .find(|md| {
+                    md.config == WORKING_CONFIG
+                        && m.module.r_big1 * md.module.alpha.cos() > m.module.r_small1
+                })
+                .unwrap();
+            PathPoint::new(md.tool.tip, md.axis)
+        })
+        .collect();
+    // (The rows are far beyond the strokes and near singularities: row findings, which do
+    // not stop the segment's checks; the slider step limit is lifted.)
+    let (_, found) = run(
+        &m,
+        &thresholds(&[("rho_step_mm", 5000.0)]),
+        oks(&joints),
+        path,
+    );
+    let branch = of(&found, Check::Branch);
+    assert_eq!(branch.len(), 1, "{found:?}");
+    // Samples at most SEGMENT_SAMPLE_MM of slider travel apart, an even number: the module
+    // leaves at the first, s = 1/n, leg I's slider then below its attachment.
+    let travel = (ends[1] - ends[0]).amax();
+    let n = 2.0 * (travel / (2.0 * SEGMENT_SAMPLE_MM)).ceil();
+    assert_eq!(n, 482.0);
+    let v = branch[0];
+    assert_eq!((v.row.as_str(), v.value), ("2", 1.0 / n));
+    assert!(
+        v.detail
+            .contains("leaves the machine's assembly mode at s = 0.0021 (s = (1,-1,-1)"),
+        "{}",
+        v.detail
+    );
 }
