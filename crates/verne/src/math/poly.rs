@@ -272,6 +272,63 @@ mod tests {
         }
     }
 
+    /// A root at an end of the interval crosses zero there (it is no critical point):
+    /// (x - 1)(x + 5) on [0, 1] and on [1, 2].
+    #[test]
+    fn a_root_at_an_end_is_not_touching() {
+        let c = from_roots(&[1.0, -5.0]);
+        for (lo, hi) in [(0.0, 1.0), (1.0, 2.0)] {
+            let r = roots_in(&c, lo, hi);
+            assert_eq!(r.len(), 1, "[{lo}, {hi}]: {r:?}");
+            assert_eq!((r[0].x, r[0].touching), (1.0, false), "[{lo}, {hi}]");
+        }
+    }
+
+    /// p = (x - 1/2)^3 + d (x - 1/2), d > 0: p' never vanishes (its minimum, d at 1/2), but
+    /// with an error of e on every coefficient p' is known only to within its own error, sum
+    /// i e |x|^(i-1) (2.75 e at 1/2): with d = 2 e below that, the root at 1/2 may be a double
+    /// root of the exact polynomial and is reported touching; with d = 4 e above it, crossing.
+    #[test]
+    fn a_root_where_p_prime_may_vanish_within_its_error_is_touching() {
+        let e = 1e-12;
+        for (d, touching) in [(2.0 * e, true), (4.0 * e, false)] {
+            // x^3 - 1.5 x^2 + (0.75 + d) x - (0.125 + d / 2), exact at x = 1/2.
+            let c = [-(0.125 + 0.5 * d), 0.75 + d, -1.5, 1.0];
+            let r = roots_in_with_error(&c, &[e; 4], 0.0, 1.0);
+            assert_eq!(r.len(), 1, "{d}: {r:?}");
+            assert!((r[0].x - 0.5).abs() < 1e-4, "{d}: {r:?}");
+            assert_eq!(r[0].touching, touching, "{d}: {r:?}");
+        }
+    }
+
+    /// A root found twice (as a piece's end and as a critical point) is one root: pushes within
+    /// 4 eps (1 + |x|) of the last one merge, touching only if both were; farther apart, two.
+    #[test]
+    fn roots_within_rounding_of_each_other_merge() {
+        for x in [0.0, 1000.0, -3.0e6] {
+            let tol = 4.0 * f64::EPSILON * (1.0 + f64::abs(x));
+            let mut out = Roots::new();
+            push_unique(&mut out, Root { x, touching: true });
+            push_unique(
+                &mut out,
+                Root {
+                    x: x + 0.9 * tol,
+                    touching: false,
+                },
+            );
+            assert_eq!(out.len(), 1, "{x}: {out:?}");
+            assert_eq!((out[0].x, out[0].touching), (x, false), "{x}");
+            push_unique(
+                &mut out,
+                Root {
+                    x: x + 2.5 * tol,
+                    touching: true,
+                },
+            );
+            assert_eq!(out.len(), 2, "{x}: {out:?}");
+        }
+    }
+
     #[test]
     fn the_zero_polynomial_has_no_isolated_root() {
         // Every coefficient zero (or none): nothing to isolate, nothing reported, no panic.
