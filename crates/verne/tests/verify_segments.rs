@@ -14,14 +14,14 @@ use nalgebra::Vector3;
 use verify_data::*;
 use verne::machine::orientation::{AxisAngles, ToolOrientation, axis_angles};
 use verne::machine::{FirstRowChoice, PathState, ToolPose, machine_fk, machine_ik};
-use verne::parallel_module::branches::WORKING_CONFIG;
-use verne::parallel_module::equations::{ModulePose, Sliders, polish_pose};
+use verne::parallel_module::branches::{WORKING_CONFIG, config_of};
+use verne::parallel_module::equations::{ModulePose, Sliders, polish_pose, rod_tilts};
 use verne::parallel_module::fk;
 use verne::parallel_module::ik::wrap_angle;
 use verne::parallel_module::kinetostatics::kinetostatics;
 use verne::spec::Machine;
 use verne::verify::{
-    Check, JOINT_NAMES, Joints, PathPoint, SEGMENT_SAMPLE_MM, Thresholds, Violation,
+    Check, JOINT_NAMES, Joints, PathPoint, SEGMENT_SAMPLE_MM, Summary, Th, Thresholds, Violation,
 };
 
 fn oks(joints: &[Joints]) -> Vec<Result<Joints, String>> {
@@ -255,14 +255,23 @@ fn without_t_the_segment_time_comes_from_durations_then_the_feed() {
     assert_eq!(v.len(), 1, "{found:?}");
     assert_eq!(v[0].0, (k + 2).to_string());
     assert!((v[0].1 - top).abs() <= 1e-9 * top, "{v:?} vs {top}");
-    // A feed that is zero or negative gives no time.
+    // A feed that is zero or negative gives no time: on that segment alone, nothing is
+    // measured (a zero feed's infinite time would measure a speed of 0).
     for bad in [0.0, -10.0] {
         let mut p = path.clone();
         p[k + 1].feed = Some(bad);
         assert!(
-            rho_speed(&run(&m, &th, oks(&joints), p).1).is_empty(),
+            rho_speed(&run(&m, &th, oks(&joints), p.clone()).1).is_empty(),
             "{bad}"
         );
+        let (summary, found) = run(&m, &th, oks(&joints[k..k + 2]), p[k..k + 2].to_vec());
+        assert!(found.is_empty(), "{bad}: {found:?}");
+        let (_, stats) = summary
+            .checks
+            .iter()
+            .find(|(c, _)| *c == Check::Velocity)
+            .unwrap();
+        assert!(stats.worst.is_none(), "{bad}: {stats:?}");
     }
     // Durations come before the feed: the joints' (0.5 s: too slow to break the limit) before
     // the path's (1e-4 s: far too fast).
@@ -421,6 +430,42 @@ fn a_row_in_the_other_orientation_solution_is_a_branch_change_on_both_segments()
     assert!(of(&found, Check::JointJump).is_empty(), "{found:?}");
 }
 
+/// The joints of a tool pose from its axis's first orientation solution, in the working branch
+/// whose theta1 is nearest the previous row's (the smallest without one), theta2 unwrapped near
+/// the previous row's.
+fn joints_for(
+    m: &Machine,
+    tip: &Vector3<f64>,
+    axis: &Vector3<f64>,
+    prev: Option<&Joints>,
+) -> Joints {
+    let Ok(AxisAngles::Regular(sols)) = axis_angles(axis) else {
+        panic!("a regular axis expected: {axis:?}")
+    };
+    let pose = ToolPose {
+        tip: *tip,
+        phi1: sols[0].phi1,
+        phi2: sols[0].phi2,
+    };
+    let b = machine_ik(m, &pose, m.tool_length)
+        .into_iter()
+        .filter(|b| b.working())
+        .min_by(|x, y| {
+            let d = |t: f64| prev.map_or(t.abs(), |p| (t - p.theta1).abs());
+            d(x.theta1).total_cmp(&d(y.theta1))
+        })
+        .unwrap();
+    Joints {
+        rho: b.rho,
+        theta1: b.theta1,
+        theta2: prev.map_or(b.theta2, |p| p.theta2 + wrap_angle(b.theta2 - p.theta2)),
+        t: None,
+        feed: None,
+        duration: None,
+        rapid: false,
+    }
+}
+
 /// A pass whose tool axis crosses the table normal between rows 30 and 31 (gamma from 14.75
 /// to -14.75 deg in 0.5 deg steps), the joints of the first orientation solution nearest the
 /// previous row, theta2 unwrapped: theta2 turns by half a turn between those rows.
@@ -431,32 +476,7 @@ fn through_the_normal(m: &Machine) -> (Vec<Joints>, Vec<PathPoint>) {
         let gamma = (14.75 - 0.5 * k as f64).to_radians();
         let tip = Vector3::new(-15.0 + 0.5 * k as f64, 10.0, 40.0);
         let axis = Vector3::new(gamma.sin(), 0.0, gamma.cos());
-        let Ok(AxisAngles::Regular(sols)) = axis_angles(&axis) else {
-            panic!("a regular axis expected")
-        };
-        let prev = joints.last().copied();
-        let pose = ToolPose {
-            tip,
-            phi1: sols[0].phi1,
-            phi2: sols[0].phi2,
-        };
-        let b = machine_ik(m, &pose, m.tool_length)
-            .into_iter()
-            .filter(|b| b.working())
-            .min_by(|x, y| {
-                let d = |t: f64| prev.map_or(t.abs(), |p| (t - p.theta1).abs());
-                d(x.theta1).total_cmp(&d(y.theta1))
-            })
-            .unwrap();
-        joints.push(Joints {
-            rho: b.rho,
-            theta1: b.theta1,
-            theta2: prev.map_or(b.theta2, |p| p.theta2 + wrap_angle(b.theta2 - p.theta2)),
-            t: None,
-            feed: None,
-            duration: None,
-            rapid: false,
-        });
+        joints.push(joints_for(m, &tip, &axis, joints.last()));
         path.push(PathPoint::new(tip, axis));
     }
     (joints, path)
@@ -628,7 +648,7 @@ fn an_amplification_peak_between_two_rows_is_found_mid_segment() {
         &m,
         &thresholds(&[("lambda_max", limit)]),
         oks(&joints[window.clone()]),
-        path[window].to_vec(),
+        path[window.clone()].to_vec(),
     );
     assert_eq!(found.len(), 1, "{found:?}");
     let v = &found[0];
@@ -641,6 +661,113 @@ fn an_amplification_peak_between_two_rows_is_found_mid_segment() {
         mids[e - 1]
     );
     assert_eq!(v.limit, limit);
+    // With the limit just above the peak (and the other two singularity limits far away), the
+    // summary's closest approach is that midpoint, within the limit.
+    let th = thresholds(&[
+        ("lambda_max", mids[e - 1] * (1.0 + 1e-9)),
+        ("lambda_min", 1e-9),
+        ("parallel_margin_min", 1e-12),
+    ]);
+    let (summary, found) = run(&m, &th, oks(&joints[window.clone()]), path[window].to_vec());
+    assert!(found.is_empty(), "{found:?}");
+    let worst = worst_of(&summary, Check::Singularity);
+    assert_eq!(worst.row, "11");
+    assert!((worst.value - mids[e - 1]).abs() < 1e-9, "{worst:?}");
+    assert_eq!(worst.detail, "mid-segment (within the limit)");
+}
+
+fn worst_of(summary: &Summary, check: Check) -> Violation {
+    let (_, stats) = summary.checks.iter().find(|(c, _)| *c == check).unwrap();
+    stats
+        .worst
+        .clone()
+        .unwrap_or_else(|| panic!("{check:?}: nothing measured"))
+}
+
+/// The summary's closest approach to the jump and speed limits on a clean run: the joint
+/// change (and speed) largest relative to its limit, with its value and limit in mm or degrees;
+/// a rapid move is not measured against the jump limit.
+#[test]
+fn the_summary_gives_the_jump_and_the_speed_closest_to_their_limits() {
+    let m = Machine::default_verne();
+    let (joints, path) = clean();
+    // (segment, joint, value) with the largest value / limit, skipping segment `skip`.
+    let closest = |values: &dyn Fn(usize) -> Vec<f64>, limits: &[f64; 5], skip: Option<usize>| {
+        (0..5)
+            .flat_map(|i| {
+                values(i)
+                    .into_iter()
+                    .enumerate()
+                    .map(move |(k, v)| (k, i, v))
+            })
+            .filter(|(k, _, _)| Some(*k) != skip)
+            .max_by(|a, b| (a.2 / limits[a.1]).total_cmp(&(b.2 / limits[b.1])))
+            .unwrap()
+    };
+    let jumps = |i: usize| -> Vec<f64> {
+        change(&joints, i)
+            .iter()
+            .map(|d| shown(i, d.abs()))
+            .collect()
+    };
+    let check = |worst: &Violation, (k, i, v): (usize, usize, f64), limits: &[f64; 5]| {
+        assert_eq!(worst.row, (k + 2).to_string(), "{worst:?}");
+        assert!((worst.value - v).abs() <= 1e-12 * v, "{worst:?} vs {v}");
+        assert!(
+            (worst.limit - limits[i]).abs() <= 1e-12 * limits[i],
+            "{worst:?}"
+        );
+        assert_eq!(
+            worst.detail,
+            format!("{} (within the limit)", JOINT_NAMES[i])
+        );
+    };
+    // The default limits (theta2 comes closest), then each joint group made the closest by
+    // widening the others' limits ten thousandfold: each is reported in its own unit.
+    let steps = [Th::RhoStepMm, Th::Theta1StepDeg, Th::Theta2StepDeg];
+    let speed_limits = [
+        Th::RhoVelocityMmS,
+        Th::Theta1VelocityDegS,
+        Th::Theta2VelocityDegS,
+    ];
+    for favoured in [None, Some(0), Some(1), Some(2)] {
+        let mut th = Thresholds::default();
+        for group in [steps, speed_limits] {
+            for (g, key) in group.into_iter().enumerate() {
+                if favoured.is_some_and(|f| f != g) {
+                    let name = verne::verify::THRESHOLDS[key as usize].name;
+                    th.set(name, 1e4 * th.get(key)).unwrap();
+                }
+            }
+        }
+        let per_joint = |[rho, theta1, theta2]: [Th; 3]| {
+            let (r, t1, t2) = (th.get(rho), th.get(theta1), th.get(theta2));
+            [r, r, r, t1, t2]
+        };
+        let (step, vmax) = (per_joint(steps), per_joint(speed_limits));
+        let (summary, found) = run(&m, &th, oks(&joints), path.clone());
+        assert!(found.is_empty(), "{favoured:?}: {found:?}");
+        let top = closest(&jumps, &step, None);
+        let group_of = |i: usize| i.saturating_sub(2);
+        if let Some(f) = favoured {
+            assert_eq!(group_of(top.1), f);
+        }
+        check(&worst_of(&summary, Check::JointJump), top, &step);
+        check(
+            &worst_of(&summary, Check::Velocity),
+            closest(&|i| speeds(&joints, i), &vmax, None),
+            &vmax,
+        );
+        // That segment a rapid move: the next closest jump.
+        let mut rapid = path.clone();
+        rapid[top.0 + 1].rapid = true;
+        let (summary, _) = run(&m, &th, oks(&joints), rapid);
+        check(
+            &worst_of(&summary, Check::JointJump),
+            closest(&jumps, &step, Some(top.0)),
+            &step,
+        );
+    }
 }
 
 /// Two slider triples, each with a mode of the machine's kind, found by a scan of random
@@ -701,4 +828,211 @@ fn joints_that_leave_the_machine_s_assembly_mode_mid_segment_are_a_branch_change
         "{}",
         v.detail
     );
+}
+
+/// A move that turns the tool about a fixed tip has no length, so a feed does not time it
+/// (docs/verify.md): no speed is checked, although the joints move.
+#[test]
+fn a_turn_about_a_fixed_tip_under_a_feed_is_not_timed() {
+    let m = Machine::default_verne();
+    let tip = Vector3::new(10.0, 20.0, 40.0);
+    let tilt = |deg: f64| Vector3::new(deg.to_radians().sin(), 0.0, deg.to_radians().cos());
+    let a = joints_for(&m, &tip, &tilt(10.0), None);
+    let b = joints_for(&m, &tip, &tilt(11.0), Some(&a));
+    assert!((b.theta1 - a.theta1).abs() > 1e-3, "{a:?} {b:?}");
+    let path: Vec<PathPoint> = [10.0, 11.0]
+        .iter()
+        .map(|&d| PathPoint {
+            feed: Some(10.0),
+            ..PathPoint::new(tip, tilt(d))
+        })
+        .collect();
+    let (summary, found) = run(&m, &Thresholds::default(), vec![Ok(a), Ok(b)], path);
+    assert!(found.is_empty(), "{found:?}");
+    let (_, stats) = summary
+        .checks
+        .iter()
+        .find(|(c, _)| *c == Check::Velocity)
+        .unwrap();
+    assert!(stats.worst.is_none(), "{stats:?}");
+}
+
+/// A row over the rod-tilt or the amplification limit is that row's finding only: the
+/// segments next to it are not sampled for the same limit (their samples near the row would
+/// repeat it). The limit is set between the second largest row value and a midpoint next to
+/// the largest row, so that a sampled segment would be a finding.
+#[test]
+fn a_row_over_a_limit_leaves_its_segments_unsampled_for_it() {
+    let (joints, _) = clean();
+    let m = Machine::default_verne();
+    let g = &m.module;
+    let pose_at = |rho: &Sliders, near: Option<ModulePose>| match near {
+        None => fk::working(&fk::solve(&m, rho)).unwrap().pose,
+        Some(p) => polish_pose(g, p, rho),
+    };
+    let tilt = |pose: &ModulePose, rho: &Sliders| {
+        rod_tilts(g, pose, rho)
+            .iter()
+            .fold(0.0f64, |a, t| a.max(*t))
+            .to_degrees()
+    };
+    let lambda = |pose: &ModulePose, rho: &Sliders| kinetostatics(g, pose, rho).amplification[0];
+    type Measure<'a> = &'a dyn Fn(&ModulePose, &Sliders) -> f64;
+    for (name, measure, check) in [
+        ("rod_tilt_max", &tilt as Measure, Check::Limits),
+        ("lambda_max", &lambda as Measure, Check::Singularity),
+    ] {
+        let rows: Vec<f64> = joints
+            .iter()
+            .map(|q| measure(&pose_at(&q.rho, None), &q.rho))
+            .collect();
+        let mut order: Vec<usize> = (0..rows.len()).collect();
+        order.sort_by(|a, b| rows[*b].total_cmp(&rows[*a]));
+        let (k, second) = (order[0], rows[order[1]]);
+        let mid = [k.wrapping_sub(1), k + 1]
+            .into_iter()
+            .filter(|&j| j < rows.len())
+            .map(|j| {
+                let (a, b) = (&joints[j.min(k)], &joints[j.max(k)]);
+                let rho = a.rho + (b.rho - a.rho) * 0.5;
+                measure(&pose_at(&rho, Some(pose_at(&a.rho, None))), &rho)
+            })
+            .fold(f64::MIN, f64::max);
+        assert!(
+            mid > second && mid < rows[k],
+            "{name}: {second} {mid} {}",
+            rows[k]
+        );
+        let limit = 0.5 * (second + mid);
+        let (m, th) = if name == "rod_tilt_max" {
+            (
+                machine(&format!("rod_tilt_max = {limit}")),
+                Thresholds::default(),
+            )
+        } else {
+            (Machine::default_verne(), thresholds(&[(name, limit)]))
+        };
+        let (_, found) = run_clean(&m, &th);
+        let over = of(&found, check);
+        assert_eq!(over.len(), 1, "{name}: {found:?}");
+        assert_eq!(over[0].row, (k + 1).to_string(), "{name}");
+        assert!(
+            (over[0].value - rows[k]).abs() < 1e-9,
+            "{name}: {:?}",
+            over[0]
+        );
+    }
+}
+
+/// A rod tilted most between two rows: on a machine whose legs II and III stand closer
+/// (r4 = 300 mm: the platform's attachments, 190 mm off its centre, swing past the slider
+/// columns), a scan of random segments found interior maxima of rod tilt (12 of 13,233; none
+/// on the VERNE machine in 200,000). With the tilt limit between the ends' tilts and the
+/// interior maximum, that segment is a finding at the maximum, refined between the samples to
+/// the value found here by a golden-section search on the tracked poses.
+#[test]
+fn a_rod_tilt_peak_between_two_rows_is_found_at_its_maximum() {
+    let m = Machine::from_toml_str(
+        "base = \"verne\"\n[module]\nr4 = 300.0\n[limits]\nrod_tilt_max = 80.28\n",
+        "test",
+    )
+    .unwrap();
+    let g = &m.module;
+    let ends = [
+        Vector3::new(529.3934706124653, -182.138342247086, 198.23287709284347),
+        Vector3::new(637.1946331507618, 51.03363321207647, 788.7988728503867),
+    ];
+    let start = fk::solve(&m, &ends[0])
+        .iter()
+        .map(|md| md.pose)
+        .find(|p| {
+            config_of(g, p, &ends[0]) == WORKING_CONFIG && g.r_big1 * p.alpha.cos() > g.r_small1
+        })
+        .unwrap();
+    // The pose tracked from the start to s (in steps of at most 1 mm of slider travel).
+    let tracked = |s: f64| -> ModulePose {
+        let steps = ((ends[1] - ends[0]).amax() * s).ceil().max(1.0) as usize;
+        (1..=steps).fold(start, |p, k| {
+            polish_pose(
+                g,
+                p,
+                &(ends[0] + (ends[1] - ends[0]) * (s * k as f64 / steps as f64)),
+            )
+        })
+    };
+    let tilt_at = |s: f64| -> f64 {
+        let rho = ends[0] + (ends[1] - ends[0]) * s;
+        rod_tilts(g, &tracked(s), &rho)
+            .iter()
+            .fold(0.0f64, |a, t| a.max(*t))
+            .to_degrees()
+    };
+    // Golden-section search for the maximum.
+    let (mut a, mut b) = (0.0, 1.0);
+    let r = 0.5 * (5f64.sqrt() - 1.0);
+    for _ in 0..80 {
+        let (x1, x2) = (b - r * (b - a), a + r * (b - a));
+        if tilt_at(x1) < tilt_at(x2) {
+            a = x1;
+        } else {
+            b = x2;
+        }
+    }
+    let (s_max, t_max) = (0.5 * (a + b), tilt_at(0.5 * (a + b)));
+    let end_pose = tracked(1.0);
+    let joints: Vec<Joints> = ends
+        .iter()
+        .map(|rho| Joints {
+            rho: *rho,
+            theta1: 0.0,
+            theta2: 0.0,
+            t: None,
+            feed: None,
+            duration: None,
+            rapid: false,
+        })
+        .collect();
+    let path: Vec<PathPoint> = [start, end_pose]
+        .iter()
+        .zip(&ends)
+        .map(|(pose, rho)| {
+            let md = machine_fk(&m, rho, 0.0, 0.0, m.tool_length)
+                .into_iter()
+                .filter(|md| md.config == WORKING_CONFIG)
+                .min_by(|x, y| {
+                    (x.module.p - pose.p)
+                        .norm()
+                        .total_cmp(&(y.module.p - pose.p).norm())
+                })
+                .unwrap();
+            PathPoint::new(md.tool.tip, md.axis)
+        })
+        .collect();
+    let th = thresholds(&[("rho_step_mm", 5000.0), ("chord_error_mm", 1000.0)]);
+    let (_, found) = run(&m, &th, oks(&joints), path);
+    let tilts = of(&found, Check::Limits)
+        .into_iter()
+        .filter(|v| v.detail.contains("mid-segment"))
+        .collect::<Vec<_>>();
+    assert_eq!(tilts.len(), 1, "{found:?}");
+    let v = tilts[0];
+    assert_eq!(v.row, "2");
+    assert!((v.limit - 80.28).abs() < 1e-9, "{v:?}");
+    // The refined maximum is a tilt at a tracked pose: at most the true maximum, and within
+    // 1e-9 deg of it (the nearest 2 mm sample alone is about 1e-5 deg short).
+    assert!(
+        v.value <= t_max + 1e-10 && v.value > t_max - 1e-9,
+        "{v:?} vs {t_max}"
+    );
+    let ends_detail = format!(
+        "at s = {s_max:.4} (ends {:.4} and {:.4} deg)",
+        tilt_at(0.0),
+        tilt_at(1.0)
+    );
+    assert!(
+        v.detail.contains(&ends_detail),
+        "{} vs {ends_detail}",
+        v.detail
+    );
+    assert!(tilt_at(0.0).max(tilt_at(1.0)) < 80.28 && t_max > 80.28);
 }
