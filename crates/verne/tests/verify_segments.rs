@@ -1019,7 +1019,7 @@ fn a_rod_tilt_peak_between_two_rows_is_found_at_its_maximum() {
     assert_eq!(v.row, "2");
     assert!((v.limit - 80.28).abs() < 1e-9, "{v:?}");
     // The refined maximum is a tilt at a tracked pose: at most the true maximum, and within
-    // 1e-9 deg of it (the nearest 2 mm sample alone is about 1e-5 deg short).
+    // 1e-9 deg of it (the nearest 2 mm sample alone is 6e-7 deg short).
     assert!(
         v.value <= t_max + 1e-10 && v.value > t_max - 1e-9,
         "{v:?} vs {t_max}"
