@@ -925,9 +925,9 @@ fn a_row_over_a_limit_leaves_its_segments_unsampled_for_it() {
 }
 
 /// A rod tilted most between two rows: on a machine whose legs II and III stand closer
-/// (r4 = 300 mm: the platform's attachments, 190 mm off its centre, swing past the slider
-/// columns), a scan of random segments found interior maxima of rod tilt (12 of 13,233; none
-/// on the VERNE machine in 200,000). With the tilt limit between the ends' tilts and the
+/// (r4 = 300 mm instead of 565 mm), a scan of random segments with both ends in the machine's
+/// mode found interior maxima of rod tilt (12 of 13,233; 101 of 3,187 at r4 = 150 mm; none on
+/// the VERNE machine in 200,000 segments). With the tilt limit between the ends' tilts and the
 /// interior maximum, that segment is a finding at the maximum, refined between the samples to
 /// the value found here by a golden-section search on the tracked poses.
 #[test]
