@@ -9,8 +9,6 @@ mod verify_data;
 
 use nalgebra::{Rotation3, Unit, Vector3};
 use verify_data::*;
-use verne::machine::machine_fk;
-use verne::parallel_module::branches::WORKING_CONFIG;
 use verne::spec::Machine;
 use verne::verify::{Check, Joints, PathPoint, Thresholds, VerifyOptions, Violation, verify};
 
@@ -30,7 +28,7 @@ fn the_clean_rows_find_nothing_and_measure_each_check() {
         Check::Limits,
         Check::Singularity,
     ] {
-        let (_, stats) = summary.checks.iter().find(|(c, _)| *c == check).unwrap();
+        let stats = stats(&summary, check);
         let worst = stats.worst.as_ref().unwrap_or_else(|| panic!("{check:?}"));
         assert_eq!(stats.count, 0);
         assert!(
@@ -163,11 +161,7 @@ fn a_rod_tilted_beyond_its_limit_is_found_with_its_tilt() {
     // The clean run's largest tilt (its worst Limits measurement), then a limit just below it.
     let m = Machine::default_verne();
     let (summary, _) = run_clean(&m, &Thresholds::default());
-    let (_, stats) = summary
-        .checks
-        .iter()
-        .find(|(c, _)| *c == Check::Limits)
-        .unwrap();
+    let stats = stats(&summary, Check::Limits);
     let tilt = stats.worst.as_ref().unwrap().value;
     assert!(tilt > 1.0 && tilt < 60.0, "{tilt}");
     let limit = tilt - 0.01;
@@ -191,11 +185,7 @@ fn a_rod_tilted_beyond_its_limit_is_found_with_its_tilt() {
 fn amplification_and_parallel_margin_limits_are_found_with_their_values() {
     let m = Machine::default_verne();
     let (summary, _) = run_clean(&m, &Thresholds::default());
-    let (_, stats) = summary
-        .checks
-        .iter()
-        .find(|(c, _)| *c == Check::Singularity)
-        .unwrap();
+    let stats = stats(&summary, Check::Singularity);
     assert!(stats.worst.is_some());
     // Thresholds that every row breaks: the largest factor above a tiny ceiling, the smallest
     // below a floor above it, the margin below a floor of 1.
@@ -322,7 +312,7 @@ fn a_value_exactly_at_its_limit_is_within_it() {
     let worst_of = |th: &Thresholds, check: Check| -> Violation {
         let (summary, found) = run_clean(&m, th);
         assert!(found.is_empty(), "{found:?}");
-        let (_, stats) = summary.checks.iter().find(|(c, _)| *c == check).unwrap();
+        let stats = stats(&summary, check);
         stats.worst.clone().unwrap()
     };
     // The tip: exceeds(value, limit) is value > limit.
@@ -350,32 +340,16 @@ fn a_value_exactly_at_its_limit_is_within_it() {
     assert!(!of(&found, Check::Singularity).is_empty(), "{found:?}");
 }
 
-/// Joints with two assembly modes of the machine's kind (a thin set: 9 of 200,000 random slider
-/// triples, found by a scan): the row is checked in the mode nearest its intended tip, so
-/// either mode's pose as the intended one finds no tip or axis error.
+/// Joints with two assembly modes of the machine's kind: the row is checked in the mode nearest
+/// its intended tip, so either mode's pose as the intended one finds no tip or axis error.
 #[test]
 fn the_mode_nearest_the_intended_tip_is_checked() {
     let m = Machine::default_verne();
-    let q = Joints {
-        rho: Vector3::new(993.8134583763522, 36.74643683672117, 373.9948975572779),
-        theta1: 0.1,
-        theta2: 0.2,
-        t: None,
-        feed: None,
-        duration: None,
-        rapid: false,
-    };
-    let modes = machine_fk(&m, &q.rho, q.theta1, q.theta2, m.tool_length);
-    let kind: Vec<_> = modes
-        .iter()
-        .filter(|md| {
-            md.config == WORKING_CONFIG
-                && m.module.r_big1 * md.module.alpha.cos() > m.module.r_small1
-        })
-        .collect();
-    assert_eq!(kind.len(), 2, "{modes:?}");
+    let q = joints_with_two_modes();
+    let kind = modes_of_the_machine_kind(&m, &q);
+    assert_eq!(kind.len(), 2, "{kind:?}");
     assert!((kind[0].tool.tip - kind[1].tool.tip).norm() > 10.0);
-    for md in kind {
+    for md in &kind {
         let (_, found) = run(
             &m,
             &Thresholds::default(),

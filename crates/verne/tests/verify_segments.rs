@@ -266,11 +266,7 @@ fn without_t_the_segment_time_comes_from_durations_then_the_feed() {
         );
         let (summary, found) = run(&m, &th, oks(&joints[k..k + 2]), p[k..k + 2].to_vec());
         assert!(found.is_empty(), "{bad}: {found:?}");
-        let (_, stats) = summary
-            .checks
-            .iter()
-            .find(|(c, _)| *c == Check::Velocity)
-            .unwrap();
+        let stats = stats(&summary, Check::Velocity);
         assert!(stats.worst.is_none(), "{bad}: {stats:?}");
     }
     // Durations come before the feed: the joints' (0.5 s: too slow to break the limit) before
@@ -455,15 +451,11 @@ fn joints_for(
             d(x.theta1).total_cmp(&d(y.theta1))
         })
         .unwrap();
-    Joints {
-        rho: b.rho,
-        theta1: b.theta1,
-        theta2: prev.map_or(b.theta2, |p| p.theta2 + wrap_angle(b.theta2 - p.theta2)),
-        t: None,
-        feed: None,
-        duration: None,
-        rapid: false,
-    }
+    at_rest(
+        b.rho,
+        b.theta1,
+        prev.map_or(b.theta2, |p| p.theta2 + wrap_angle(b.theta2 - p.theta2)),
+    )
 }
 
 /// A pass whose tool axis crosses the table normal between rows 30 and 31 (gamma from 14.75
@@ -533,22 +525,9 @@ fn half_a_turn_of_theta2_through_the_table_normal_is_a_flip() {
 #[test]
 fn a_segment_that_arrives_in_another_assembly_mode_is_a_branch_change() {
     let m = Machine::default_verne();
-    let q = Joints {
-        rho: Vector3::new(993.8134583763522, 36.74643683672117, 373.9948975572779),
-        theta1: 0.1,
-        theta2: 0.2,
-        t: None,
-        feed: None,
-        duration: None,
-        rapid: false,
-    };
-    let modes = machine_fk(&m, &q.rho, q.theta1, q.theta2, m.tool_length);
-    let points: Vec<PathPoint> = modes
+    let q = joints_with_two_modes();
+    let points: Vec<PathPoint> = modes_of_the_machine_kind(&m, &q)
         .iter()
-        .filter(|md| {
-            md.config == WORKING_CONFIG
-                && m.module.r_big1 * md.module.alpha.cos() > m.module.r_small1
-        })
         .map(|md| PathPoint::new(md.tool.tip, md.axis))
         .collect();
     assert_eq!(points.len(), 2);
@@ -677,8 +656,7 @@ fn an_amplification_peak_between_two_rows_is_found_mid_segment() {
 }
 
 fn worst_of(summary: &Summary, check: Check) -> Violation {
-    let (_, stats) = summary.checks.iter().find(|(c, _)| *c == check).unwrap();
-    stats
+    stats(summary, check)
         .worst
         .clone()
         .unwrap_or_else(|| panic!("{check:?}: nothing measured"))
@@ -780,28 +758,11 @@ fn joints_that_leave_the_machine_s_assembly_mode_mid_segment_are_a_branch_change
         Vector3::new(1114.8098962832719, 457.0534324386325, 179.893518392908),
         Vector3::new(151.5151959394836, -177.48689885838002, 264.4637304372717),
     ];
-    let joints: Vec<Joints> = ends
-        .iter()
-        .map(|rho| Joints {
-            rho: *rho,
-            theta1: 0.0,
-            theta2: 0.0,
-            t: None,
-            feed: None,
-            duration: None,
-            rapid: false,
-        })
-        .collect();
+    let joints: Vec<Joints> = ends.iter().map(|rho| at_rest(*rho, 0.0, 0.0)).collect();
     let path: Vec<PathPoint> = joints
         .iter()
         .map(|q| {
-            let md = machine_fk(&m, &q.rho, 0.0, 0.0, m.tool_length)
-                .into_iter()
-                .find(|md| {
-                    md.config == WORKING_CONFIG
-                        && m.module.r_big1 * md.module.alpha.cos() > m.module.r_small1
-                })
-                .unwrap();
+            let md = &modes_of_the_machine_kind(&m, q)[0];
             PathPoint::new(md.tool.tip, md.axis)
         })
         .collect();
@@ -849,11 +810,7 @@ fn a_turn_about_a_fixed_tip_under_a_feed_is_not_timed() {
         .collect();
     let (summary, found) = run(&m, &Thresholds::default(), vec![Ok(a), Ok(b)], path);
     assert!(found.is_empty(), "{found:?}");
-    let (_, stats) = summary
-        .checks
-        .iter()
-        .find(|(c, _)| *c == Check::Velocity)
-        .unwrap();
+    let stats = stats(&summary, Check::Velocity);
     assert!(stats.worst.is_none(), "{stats:?}");
 }
 
@@ -980,18 +937,7 @@ fn a_rod_tilt_peak_between_two_rows_is_found_at_its_maximum() {
     }
     let (s_max, t_max) = (0.5 * (a + b), tilt_at(0.5 * (a + b)));
     let end_pose = tracked(1.0);
-    let joints: Vec<Joints> = ends
-        .iter()
-        .map(|rho| Joints {
-            rho: *rho,
-            theta1: 0.0,
-            theta2: 0.0,
-            t: None,
-            feed: None,
-            duration: None,
-            rapid: false,
-        })
-        .collect();
+    let joints: Vec<Joints> = ends.iter().map(|rho| at_rest(*rho, 0.0, 0.0)).collect();
     let path: Vec<PathPoint> = [start, end_pose]
         .iter()
         .zip(&ends)

@@ -6,10 +6,12 @@
 use std::collections::VecDeque;
 
 use nalgebra::Vector3;
+use verne::machine::{MachineFkMode, machine_fk};
+use verne::parallel_module::branches::WORKING_CONFIG;
 use verne::spec::Machine;
 use verne::verify::{
-    Check, Item, JointSource, Joints, PairingError, PathPoint, RowSource, Summary, Thresholds,
-    VerifyOptions, Violation, verify,
+    Check, CheckStats, Item, JointSource, Joints, PairingError, PathPoint, RowSource, Summary,
+    Thresholds, VerifyOptions, Violation, verify,
 };
 
 /// Rows of data/verify read here.
@@ -144,4 +146,44 @@ pub fn of(found: &[Violation], check: Check) -> Vec<&Violation> {
 
 pub fn machine(limits: &str) -> Machine {
     Machine::from_toml_str(&format!("base = \"verne\"\n[limits]\n{limits}\n"), "test").unwrap()
+}
+
+/// What the summary measured for `check`.
+pub fn stats(summary: &Summary, check: Check) -> &CheckStats {
+    &summary.checks.iter().find(|(c, _)| *c == check).unwrap().1
+}
+
+/// Joints at rest: no time, feed or duration.
+pub fn at_rest(rho: Vector3<f64>, theta1: f64, theta2: f64) -> Joints {
+    Joints {
+        rho,
+        theta1,
+        theta2,
+        t: None,
+        feed: None,
+        duration: None,
+        rapid: false,
+    }
+}
+
+/// The assembly modes of the machine's kind (verify's rule: the working configuration, rods of
+/// leg I not crossing) at joints `q`.
+pub fn modes_of_the_machine_kind(m: &Machine, q: &Joints) -> Vec<MachineFkMode> {
+    machine_fk(m, &q.rho, q.theta1, q.theta2, m.tool_length)
+        .into_iter()
+        .filter(|md| {
+            md.config == WORKING_CONFIG
+                && m.module.r_big1 * md.module.alpha.cos() > m.module.r_small1
+        })
+        .collect()
+}
+
+/// Joints with two assembly modes of the machine's kind, their tips far apart (a thin set: 9 of
+/// 200,000 random slider triples, found by a scan).
+pub fn joints_with_two_modes() -> Joints {
+    at_rest(
+        Vector3::new(993.8134583763522, 36.74643683672117, 373.9948975572779),
+        0.1,
+        0.2,
+    )
 }
