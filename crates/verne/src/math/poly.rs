@@ -272,6 +272,29 @@ mod tests {
         }
     }
 
+    /// Roots far from 1 are refined to full relative precision: the step test is relative to
+    /// |x| (a root at 3e17, where a test of |next / x| against eps |x| would stop after one
+    /// Newton step from the piece's midpoint).
+    #[test]
+    fn a_large_root_is_found_to_full_precision() {
+        for r in [3e17, -5e20, 7e-12] {
+            let c = from_roots(&[r, 1.0]);
+            let (lo, hi) = if r > 1.0 {
+                (2.0, 10.0 * r)
+            } else if r < 0.0 {
+                (10.0 * r, 0.5)
+            } else {
+                (0.0, 0.5)
+            };
+            let got = roots_in(&c, lo, hi);
+            assert_eq!(got.len(), 1, "{r}: {got:?}");
+            assert!(
+                (got[0].x - r).abs() <= 8.0 * f64::EPSILON * r.abs(),
+                "{r}: {got:?}"
+            );
+        }
+    }
+
     /// A root at an end of the interval crosses zero there (it is no critical point):
     /// (x - 1)(x + 5) on [0, 1] and on [1, 2].
     #[test]
