@@ -418,3 +418,124 @@ pub fn machine_ik_into(
         out.sort_by(|a, b| a.theta1.total_cmp(&b.theta1).then(a.config.cmp(&b.config)));
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The leg-I path of a tool pose on the default machine.
+    fn path(m: &Machine, phi1: f64, phi2: f64) -> Leg1Path<'_> {
+        let pose = ToolPose {
+            tip: Vector3::new(20.0, -35.0, 40.0),
+            phi1,
+            phi2,
+        };
+        let (sin_phi1, cos_phi1) = phi1.sin_cos();
+        Leg1Path {
+            m,
+            w: tilt_frame_platform(&m.table, &pose, m.tool_length),
+            sin_phi1,
+            cos_phi1,
+        }
+    }
+
+    fn point(theta1: f64, rho1: f64) -> PathPoint {
+        let (sin, cos) = theta1.sin_cos();
+        PathPoint {
+            theta1,
+            sin,
+            cos,
+            rho1,
+        }
+    }
+
+    /// The Jacobian of (g1, g2) in (theta1, rho1) that Newton's polish uses is the derivative
+    /// of the equations: central differences agree to 1e-6 of the largest entry, at poses on
+    /// and off the solutions.
+    #[test]
+    fn the_leg1_jacobian_is_the_derivative_of_its_equations() {
+        let m = Machine::default_verne();
+        for (phi1, phi2) in [(0.3, 0.2), (-0.7, 2.5), (1e-3, -1.0)] {
+            let p = path(&m, phi1, phi2);
+            for (theta1, rho1) in [(0.1, 300.0), (-0.6, 650.0), (2.8, -100.0)] {
+                let (_, j) = p.eval(&point(theta1, rho1));
+                let (h_t, h_r) = (1e-6, 1e-3);
+                let d_theta1 = (p.eval(&point(theta1 + h_t, rho1)).0
+                    - p.eval(&point(theta1 - h_t, rho1)).0)
+                    / (2.0 * h_t);
+                let d_rho1 = (p.eval(&point(theta1, rho1 + h_r)).0
+                    - p.eval(&point(theta1, rho1 - h_r)).0)
+                    / (2.0 * h_r);
+                let numeric = Matrix2::from_columns(&[d_theta1, d_rho1]);
+                let scale = j.amax();
+                assert!(
+                    (j - numeric).amax() <= 1e-6 * scale,
+                    "phi1 {phi1}, theta1 {theta1}: {j} vs {numeric}"
+                );
+            }
+        }
+    }
+
+    /// A tool pose with a value that is not finite has no branch, whichever value it is.
+    #[test]
+    fn a_pose_that_is_not_finite_has_no_branch() {
+        let m = Machine::default_verne();
+        let good = ToolPose {
+            tip: Vector3::new(20.0, -35.0, 40.0),
+            phi1: 0.3,
+            phi2: 0.2,
+        };
+        assert!(!machine_ik(&m, &good, m.tool_length).is_empty());
+        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            for k in 0..6 {
+                let mut pose = good;
+                let mut tool_length = m.tool_length;
+                match k {
+                    0..=2 => pose.tip[k] = bad,
+                    3 => pose.phi1 = bad,
+                    4 => pose.phi2 = bad,
+                    _ => tool_length = bad,
+                }
+                let out = machine_ik(&m, &pose, tool_length);
+                assert!(out.is_empty(), "{bad} at {k}: {out:?}");
+            }
+        }
+    }
+
+    /// Table II's double root (IFToMM 2007): a platform point with yp = 0 and alpha = 0 has
+    /// two leg-I postures, rho1 = zp +- h, at one theta1, where F has a double root. The
+    /// machine's inverse kinematics of the tool pose built on it has both, each once (a
+    /// posture found from two seeds is merged, two postures are not).
+    #[test]
+    fn both_postures_of_table_ii_s_double_root_are_found_once() {
+        let m = Machine::default_verne();
+        let g = &m.module;
+        for (x, z, theta1, theta2) in [(30.0, 700.0, 0.2, 0.5), (-60.0, 820.0, -0.4, -2.0)] {
+            let module = ModulePose {
+                p: Vector3::new(x, 0.0, z),
+                alpha: 0.0,
+            };
+            let tool =
+                crate::machine::tool_pose_eq26(&m.table, &module, theta1, theta2, m.tool_length);
+            let u = x + g.dx1;
+            let h = (g.l1 * g.l1 - (g.r_big1 - g.r_small1).powi(2) - u * u).sqrt();
+            let ik = machine_ik(&m, &tool, m.tool_length);
+            assert!(ik.certificate.proved(), "{:?}", ik.certificate);
+            let at: Vec<&MachineIkBranch> = ik
+                .iter()
+                .filter(|b| wrap_angle(b.theta1 - theta1).abs() < 1e-9)
+                .collect();
+            for rho1 in [z + h, z - h] {
+                assert!(
+                    at.iter().any(|b| (b.rho.x - rho1).abs() < 1e-6),
+                    "rho1 = {rho1} missing: {at:?}"
+                );
+            }
+            for (k, a) in at.iter().enumerate() {
+                for b in &at[k + 1..] {
+                    assert!((a.rho - b.rho).amax() > 1e-6, "twice: {a:?}");
+                }
+            }
+        }
+    }
+}
