@@ -225,14 +225,14 @@ fn without_t_the_segment_time_comes_from_durations_then_the_feed() {
     for q in &mut joints {
         q.t = None;
     }
-    let rho_speed = |found: &[Violation]| -> Vec<(String, f64)> {
+    let speed_findings = |found: &[Violation]| -> Vec<(String, f64)> {
         of(found, Check::Velocity)
             .iter()
             .map(|v| (v.row.clone(), v.value))
             .collect()
     };
-    // A feed on the path: dt = |tip_b - tip_a| / feed. The fastest slider of the clean run at
-    // that time, then a limit just under it.
+    // A feed on the path: dt = |tip_b - tip_a| / feed. The fastest slider at those times, and
+    // a slider speed limit between it and the next.
     let feed = 10.0;
     for p in &mut path {
         p.feed = Some(feed);
@@ -251,7 +251,7 @@ fn without_t_the_segment_time_comes_from_durations_then_the_feed() {
     let [(k, _, top), (_, _, next)] = two_largest(per_segment, GROUPS[0]);
     let th = thresholds(&[("rho_velocity_mm_s", 0.5 * (top + next))]);
     let found = run(&m, &th, oks(&joints), path.clone()).1;
-    let v = rho_speed(&found);
+    let v = speed_findings(&found);
     assert_eq!(v.len(), 1, "{found:?}");
     assert_eq!(v[0].0, (k + 2).to_string());
     assert!((v[0].1 - top).abs() <= 1e-9 * top, "{v:?} vs {top}");
@@ -261,7 +261,7 @@ fn without_t_the_segment_time_comes_from_durations_then_the_feed() {
         let mut p = path.clone();
         p[k + 1].feed = Some(bad);
         assert!(
-            rho_speed(&run(&m, &th, oks(&joints), p.clone()).1).is_empty(),
+            speed_findings(&run(&m, &th, oks(&joints), p.clone()).1).is_empty(),
             "{bad}"
         );
         let (summary, found) = run(&m, &th, oks(&joints[k..k + 2]), p[k..k + 2].to_vec());
@@ -275,22 +275,23 @@ fn without_t_the_segment_time_comes_from_durations_then_the_feed() {
     p[k + 1].duration = Some(1e-4);
     let found = run(&m, &th, oks(&joints), p.clone()).1;
     assert!(
-        rho_speed(&found)
+        speed_findings(&found)
             .iter()
             .any(|(r, _)| *r == (k + 2).to_string())
     );
     let mut q = joints.clone();
     q[k + 1].duration = Some(0.5);
     let found = run(&m, &th, oks(&q), p.clone()).1;
-    assert!(rho_speed(&found).is_empty(), "{found:?}");
+    assert!(speed_findings(&found).is_empty(), "{found:?}");
     // A rapid move has no programmed time: none of them counts.
     q[k + 1].duration = Some(1e-4);
     p[k + 1].rapid = true;
     let found = run(&m, &th, oks(&q), p).1;
-    assert!(rho_speed(&found).is_empty(), "{found:?}");
+    assert!(speed_findings(&found).is_empty(), "{found:?}");
 }
 
-/// The tool tip at the joints' midpoint, in the machine's assembly mode nearest `near`.
+/// The tool tip at the joints' midpoint, in the assembly mode of the working configuration
+/// nearest `near`.
 fn midpoint_tip(m: &Machine, a: &Joints, b: &Joints, near: &Vector3<f64>) -> Vector3<f64> {
     let rho = a.rho + (b.rho - a.rho) * 0.5;
     let q1 = a.theta1 + (b.theta1 - a.theta1) * 0.5;
@@ -356,8 +357,8 @@ fn the_chordal_error_is_the_midpoint_tip_off_the_line() {
     assert!(of(&run(&m, &th, oks(&joints), rapid).1, Check::ChordError).is_empty());
 }
 
-/// The joints of row `k` from the other orientation solution of its tool pose, theta2 unwrapped
-/// near the row's.
+/// The joints `q` of path point `p` moved to the other orientation solution of its tool pose
+/// (another working branch), theta2 unwrapped near `q`'s.
 fn other_orientation(m: &Machine, q: &Joints, p: &PathPoint) -> Joints {
     let Ok(AxisAngles::Regular(sols)) = axis_angles(&p.axis) else {
         panic!("a regular axis expected: {p:?}")
