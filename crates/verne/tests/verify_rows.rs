@@ -10,7 +10,7 @@ mod verify_data;
 use nalgebra::{Rotation3, Unit, Vector3};
 use verify_data::*;
 use verne::spec::Machine;
-use verne::verify::{Check, Joints, PathPoint, Thresholds, VerifyOptions, Violation, verify};
+use verne::verify::{Check, Joints, PathPoint, Thresholds, Violation};
 
 #[test]
 fn the_clean_rows_find_nothing_and_measure_each_check() {
@@ -48,7 +48,7 @@ fn a_tip_moved_beyond_its_limit_is_found_with_its_error() {
         let mut path = path.clone();
         let moved = Vector3::new(0.6, -0.8, 0.0) * limit * scale;
         path[9].tip += moved;
-        let (_, found) = run(&m, &th, joints.iter().copied().map(Ok).collect(), path);
+        let (_, found) = run(&m, &th, oks(&joints), path);
         let tip = of(&found, Check::TipError);
         if expect {
             assert_eq!(tip.len(), 1, "{found:?}");
@@ -86,7 +86,7 @@ fn an_axis_turned_beyond_its_limit_is_found_with_its_angle() {
         let axis = path[4].axis;
         let turn = Unit::new_normalize(axis.cross(&Vector3::x()));
         path[4].axis = Rotation3::from_axis_angle(&turn, (limit * scale).to_radians()) * axis;
-        let (_, found) = run(&m, &th, joints.iter().copied().map(Ok).collect(), path);
+        let (_, found) = run(&m, &th, oks(&joints), path);
         let turned = of(&found, Check::AxisError);
         if expect {
             assert_eq!(turned.len(), 1, "{found:?}");
@@ -225,7 +225,7 @@ fn amplification_and_parallel_margin_limits_are_found_with_their_values() {
 fn joints_that_cannot_be_assembled_a_bad_row_and_a_missing_id_are_findings() {
     let m = Machine::default_verne();
     let (joints, mut path) = clean();
-    let mut rows: Vec<Result<Joints, String>> = joints.iter().copied().map(Ok).collect();
+    let mut rows: Vec<Result<Joints, String>> = oks(&joints);
     // Sliders apart: assembled only in modes of other kinds; and too far apart for the rods.
     let mut apart = joints[3];
     apart.rho = Vector3::new(0.0, 1100.0, 0.0);
@@ -235,7 +235,7 @@ fn joints_that_cannot_be_assembled_a_bad_row_and_a_missing_id_are_findings() {
     rows[7] = Err("rho2: `x` is not a number".into());
     // The path has no row 20 (the joint row 20 has no intended pose).
     path.remove(19);
-    let mut path_rows = Rows {
+    let path_rows = Rows {
         name: "path",
         items: path
             .into_iter()
@@ -243,30 +243,12 @@ fn joints_that_cannot_be_assembled_a_bad_row_and_a_missing_id_are_findings() {
             .map(|(k, v)| item(if k >= 19 { k + 1 } else { k }, Ok(v)))
             .collect(),
     };
-    let mut joint_rows = Rows {
-        name: "joints",
-        items: rows
-            .into_iter()
-            .enumerate()
-            .map(|(k, v)| item(k, v))
-            .collect(),
-    };
-    let opt = VerifyOptions {
-        thresholds: Thresholds::default(),
-        tool_length: m.tool_length,
-    };
-    let mut found = Vec::new();
-    let summary = verify(
+    let (summary, found) = run_sources(
         &m,
-        &opt,
-        &mut joint_rows,
-        &mut path_rows,
-        &mut |v: &Violation| {
-            found.push(v.clone());
-            Ok::<(), Fail>(())
-        },
-    )
-    .unwrap_or_else(|Fail(e)| panic!("{e}"));
+        &Thresholds::default(),
+        numbered("joints", rows),
+        path_rows,
+    );
     let branch = of(&found, Check::Branch);
     assert_eq!(branch.len(), 2, "{found:?}");
     assert_eq!((branch[0].row.as_str(), branch[0].value), ("4", 4.0));

@@ -24,10 +24,6 @@ use verne::verify::{
     Check, JOINT_NAMES, Joints, PathPoint, SEGMENT_SAMPLE_MM, Summary, Th, Thresholds, Violation,
 };
 
-fn oks(joints: &[Joints]) -> Vec<Result<Joints, String>> {
-    joints.iter().copied().map(Ok).collect()
-}
-
 fn thresholds(set: &[(&str, f64)]) -> Thresholds {
     let mut th = Thresholds::default();
     for (name, value) in set {
@@ -72,6 +68,23 @@ fn two_largest(
     [all[0], all[1]]
 }
 
+/// The only finding of `check`: on row `row`, with `value` and `limit` (to 1e-12).
+fn the_one_finding(
+    found: &[Violation],
+    check: Check,
+    row: usize,
+    value: f64,
+    limit: f64,
+) -> &Violation {
+    let of_check = of(found, check);
+    assert_eq!(of_check.len(), 1, "{check:?}: {found:?}");
+    let v = of_check[0];
+    assert_eq!(v.row, row.to_string(), "{v:?}");
+    assert!((v.value - value).abs() <= 1e-12 * value, "{v:?} vs {value}");
+    assert!((v.limit - limit).abs() <= 1e-12 * limit, "{v:?} vs {limit}");
+    v
+}
+
 /// The joint groups of the step and speed thresholds (one threshold for the three sliders).
 const GROUPS: [&[usize]; 3] = [&[0, 1, 2], &[3], &[4]];
 
@@ -95,15 +108,7 @@ fn the_largest_joint_change_is_a_jump_above_its_limit() {
         // but the one that jumped (a jump ends the segment's checks).
         let th = thresholds(&[(name, limit), ("rho_velocity_mm_s", 1e-9)]);
         let (_, found) = run(&m, &th, oks(&joints), path.clone());
-        let jumps = of(&found, Check::JointJump);
-        assert_eq!(jumps.len(), 1, "{name}: {jumps:?}");
-        let v = jumps[0];
-        assert_eq!(v.row, (k + 2).to_string(), "{name}");
-        assert!(
-            (v.value - top).abs() <= 1e-12 * top,
-            "{name}: {v:?} vs {top}"
-        );
-        assert!((v.limit - limit).abs() <= 1e-12 * limit, "{name}: {v:?}");
+        let v = the_one_finding(&found, Check::JointJump, k + 2, top, limit);
         let signed = shown(i, change(&joints, i)[k]);
         assert!(
             v.detail
@@ -174,15 +179,7 @@ fn the_fastest_joint_is_a_velocity_finding_above_its_limit() {
             oks(&joints),
             path.clone(),
         );
-        let fast = of(&found, Check::Velocity);
-        assert_eq!(fast.len(), 1, "{name}: {found:?}");
-        let v = fast[0];
-        assert_eq!(v.row, (k + 2).to_string(), "{name}");
-        assert!(
-            (v.value - top).abs() <= 1e-12 * top,
-            "{name}: {v:?} vs {top}"
-        );
-        assert!((v.limit - limit).abs() <= 1e-12 * limit, "{name}: {v:?}");
+        let v = the_one_finding(&found, Check::Velocity, k + 2, top, limit);
         let dt = joints[k + 1].t.unwrap() - joints[k].t.unwrap();
         assert!(
             v.detail.contains(JOINT_NAMES[i]) && v.detail.contains(&format!("(dt = {dt:.6} s)")),

@@ -99,6 +99,23 @@ pub fn clean() -> (Vec<Joints>, Vec<PathPoint>) {
     (joints, path)
 }
 
+/// Joint rows, all usable.
+pub fn oks(joints: &[Joints]) -> Vec<Result<Joints, String>> {
+    joints.iter().copied().map(Ok).collect()
+}
+
+/// Rows numbered 1, 2, ... with ids "1", "2", ...
+pub fn numbered<T>(name: &'static str, rows: Vec<Result<T, String>>) -> Rows<T> {
+    Rows {
+        name,
+        items: rows
+            .into_iter()
+            .enumerate()
+            .map(|(k, v)| item(k, v))
+            .collect(),
+    }
+}
+
 /// Runs verify on the rows (a joint row replaced by an error where `joints` holds one).
 pub fn run(
     m: &Machine,
@@ -106,28 +123,27 @@ pub fn run(
     joints: Vec<Result<Joints, String>>,
     path: Vec<PathPoint>,
 ) -> (Summary, Vec<Violation>) {
+    run_sources(
+        m,
+        th,
+        numbered("joints", joints),
+        numbered("path", path.into_iter().map(Ok).collect()),
+    )
+}
+
+/// Runs verify on two in-memory sources and collects the findings.
+pub fn run_sources(
+    m: &Machine,
+    th: &Thresholds,
+    mut joints: Rows<Joints>,
+    mut path: Rows<PathPoint>,
+) -> (Summary, Vec<Violation>) {
     let opt = VerifyOptions {
         thresholds: *th,
         tool_length: m.tool_length,
     };
-    let mut j = Rows {
-        name: "joints",
-        items: joints
-            .into_iter()
-            .enumerate()
-            .map(|(k, v)| item(k, v))
-            .collect(),
-    };
-    let mut p = Rows {
-        name: "path",
-        items: path
-            .into_iter()
-            .enumerate()
-            .map(|(k, v)| item(k, Ok(v)))
-            .collect(),
-    };
     let mut found = Vec::new();
-    let summary = verify(m, &opt, &mut j, &mut p, &mut |v: &Violation| {
+    let summary = verify(m, &opt, &mut joints, &mut path, &mut |v: &Violation| {
         found.push(v.clone());
         Ok::<(), Fail>(())
     })
