@@ -221,6 +221,98 @@ impl Leg1Path<'_> {
     }
 }
 
+/// Seeds (theta1, rho1) at the two angles where sin(alpha) = 0, theta1 = -phi1 and pi - phi1,
+/// when F is small there: both signs of rho1 - zp, rho1 = zp +- h from eq. (10) of IFToMM 2007
+/// (at a double root of F, Table II, the two postures themselves). A safety net behind the
+/// certified isolation, which predicts none of them.
+fn alpha_zero_seeds(
+    m: &Machine,
+    pose: &ToolPose,
+    path: &Leg1Path,
+    f: &Trig,
+) -> ArrayVec<(f64, f64), 4> {
+    let g = &m.module;
+    let (r, rr) = (g.r_big1, g.r_small1);
+    let f_scale = f
+        .cos
+        .iter()
+        .chain(&f.sin)
+        .fold(0.0f64, |m, a| m.max(a.abs()));
+    let mut seeds = ArrayVec::new();
+    for th in [-pose.phi1, PI - pose.phi1] {
+        let (sin, cos) = th.sin_cos();
+        if f.eval_sc(sin, cos) <= ALPHA_ZERO_SEED_REL * f_scale {
+            let (p, _) = platform_at(m.table.d_a, &path.w, sin, cos);
+            let (_, ca) = path.alpha_sin_cos(&PathPoint {
+                theta1: th,
+                sin,
+                cos,
+                rho1: 0.0,
+            });
+            let u = p.x + g.dx1;
+            let k1 = g.l1 * g.l1 - r * r - rr * rr + 2.0 * r * rr * ca;
+            let h = (k1 - u * u - p.y * p.y).max(0.0).sqrt();
+            seeds.push((th, p.z + h));
+            seeds.push((th, p.z - h));
+        }
+    }
+    seeds
+}
+
+/// The leg-I postures polished by Newton from three lists of seeds (theta1, rho1), duplicates
+/// merged: `proved`, one per proved root of F, each of which must polish to a posture within
+/// [`ROOT_POLISH_RAD`] of its theta1; `allowed`, postures an ambiguous interval's resolution
+/// allows, which may fail; `others`, seeds no proof predicts. The certificate becomes
+/// [`Certificate::Unproved`] when a proved seed fails or drifts, when a posture comes from
+/// `others` alone, or when there are more postures than F has roots.
+fn polish_postures(
+    path: &Leg1Path,
+    proved: &[(f64, f64)],
+    allowed: &[(f64, f64)],
+    others: &[(f64, f64)],
+    certificate: &mut Certificate,
+) -> ArrayVec<PathPoint, MAX_THETA1_SOLUTIONS> {
+    let g = &path.m.module;
+    let n_proved = proved.len();
+    let n_expected = n_proved + allowed.len();
+    let mut pairs: ArrayVec<PathPoint, MAX_THETA1_SOLUTIONS> = ArrayVec::new();
+    for (k, &(theta1, rho1)) in proved.iter().chain(allowed).chain(others).enumerate() {
+        let (sin, cos) = theta1.sin_cos();
+        let (q, fv) = path.polish(PathPoint {
+            theta1,
+            sin,
+            cos,
+            rho1,
+        });
+        // Residuals of (10) and (14) as lengths along the rod (mm).
+        let res = (fv.x / (2.0 * g.l1)).abs().max((fv.y / g.r_big1).abs());
+        if res.is_nan() || res > ACCEPT_RESIDUAL_MM {
+            if k < n_proved {
+                *certificate = Certificate::Unproved;
+            }
+            continue;
+        }
+        if k < n_proved && wrap_angle(q.theta1 - theta1).abs() > ROOT_POLISH_RAD {
+            *certificate = Certificate::Unproved;
+        }
+        let dup = pairs.iter().any(|o| {
+            wrap_angle(o.theta1 - q.theta1).abs() < SAME_SOLUTION_RAD
+                && (o.rho1 - q.rho1).abs() < SAME_SOLUTION_MM * (1.0 + q.rho1.abs())
+        });
+        if dup {
+            continue;
+        }
+        if k >= n_expected || pairs.is_full() {
+            *certificate = Certificate::Unproved;
+            if pairs.is_full() {
+                continue;
+            }
+        }
+        pairs.push(q);
+    }
+    pairs
+}
+
 /// Every real inverse-kinematics branch of the machine for a tool pose in R_t (AIM 2007, section
 /// III.C), ordered by theta1 then by (s1, s2, s3). theta2 = -phi2 wrapped to (-pi, pi]. Empty
 /// when the pose is unreachable by any real branch (never because of a convergence failure: the
@@ -288,9 +380,10 @@ pub fn machine_ik_into(
             None => certificate = Certificate::Unproved,
         }
     }
-    // Other seeds, which the proof does not predict: near the roots' two values where
-    // sin(alpha) = 0 when F is small there (its double roots, both signs of rho1 - zp, Table II
-    // of IFToMM 2007). A posture they find that no proved root gave makes the result unproved.
+    // Intervals the isolation left ambiguous (two roots closer than F's rounding): proved
+    // postures, postures allowed, and best-effort ones where nothing could be proved. Then the
+    // seeds the proof does not predict, at sin(alpha) = 0; a posture only they find makes the
+    // result unproved.
     let mut others: ArrayVec<(f64, f64), 12> = ArrayVec::new();
     let mut allowed: ArrayVec<(f64, f64), 12> = ArrayVec::new();
     if !iso.ambiguous.is_empty() {
@@ -305,67 +398,10 @@ pub fn machine_ik_into(
         );
         certificate = certificate.max(Certificate::from(resolution));
     }
-    let f_scale = f
-        .cos
-        .iter()
-        .chain(&f.sin)
-        .fold(0.0f64, |m, a| m.max(a.abs()));
-    for th in [-pose.phi1, PI - pose.phi1] {
-        let (sin, cos) = th.sin_cos();
-        if f.eval_sc(sin, cos) <= ALPHA_ZERO_SEED_REL * f_scale {
-            let (p, _) = platform_at(m.table.d_a, &path.w, sin, cos);
-            let (sa, ca) = path.alpha_sin_cos(&PathPoint {
-                theta1: th,
-                sin,
-                cos,
-                rho1: 0.0,
-            });
-            let u = p.x + g.dx1;
-            let k1 = g.l1 * g.l1 - r * r - rr * rr + 2.0 * r * rr * ca;
-            let h = (k1 - u * u - p.y * p.y).max(0.0).sqrt();
-            let _ = sa;
-            for rho1 in [p.z + h, p.z - h] {
-                let _ = others.try_push((th, rho1));
-            }
-        }
+    for seed in alpha_zero_seeds(m, pose, &path, &f) {
+        let _ = others.try_push(seed);
     }
-    let n_proved = proved.len();
-    let n_expected = n_proved + allowed.len();
-    let mut pairs: ArrayVec<PathPoint, MAX_THETA1_SOLUTIONS> = ArrayVec::new();
-    for (k, &(theta1, rho1)) in proved.iter().chain(&allowed).chain(&others).enumerate() {
-        let (sin, cos) = theta1.sin_cos();
-        let (q, fv) = path.polish(PathPoint {
-            theta1,
-            sin,
-            cos,
-            rho1,
-        });
-        // Residuals of (10) and (14) as lengths along the rod (mm).
-        let res = (fv.x / (2.0 * g.l1)).abs().max((fv.y / r).abs());
-        if res.is_nan() || res > ACCEPT_RESIDUAL_MM {
-            if k < n_proved {
-                certificate = Certificate::Unproved;
-            }
-            continue;
-        }
-        if k < n_proved && wrap_angle(q.theta1 - theta1).abs() > ROOT_POLISH_RAD {
-            certificate = Certificate::Unproved;
-        }
-        let dup = pairs.iter().any(|o| {
-            wrap_angle(o.theta1 - q.theta1).abs() < SAME_SOLUTION_RAD
-                && (o.rho1 - q.rho1).abs() < SAME_SOLUTION_MM * (1.0 + q.rho1.abs())
-        });
-        if dup {
-            continue;
-        }
-        if k >= n_expected || pairs.is_full() {
-            certificate = Certificate::Unproved;
-            if pairs.is_full() {
-                continue;
-            }
-        }
-        pairs.push(q);
-    }
+    let pairs = polish_postures(&path, &proved, &allowed, &others, &mut certificate);
     let theta2 = wrap_angle(-pose.phi2);
     let cos_tilt = cos_tilt_max(m);
     for q in &pairs {
@@ -502,6 +538,44 @@ mod tests {
         }
     }
 
+    /// Platform points (x, z) with yp = 0 and alpha = 0, and the table angles of their tool
+    /// poses (theta1, theta2).
+    const TABLE_II_POSES: [(f64, f64, f64, f64); 2] =
+        [(30.0, 700.0, 0.2, 0.5), (-60.0, 820.0, -0.4, -2.0)];
+
+    /// The tool pose whose platform point is (x, yp, z) at alpha = 0 with the table at
+    /// (theta1, theta2), and h, the half-distance of its two leg-I postures at yp = 0
+    /// (rho1 = z +- h, Table II of IFToMM 2007: K1 = L1^2 - (R1 - r1)^2 at alpha = 0).
+    fn table_ii_pose(
+        m: &Machine,
+        x: f64,
+        yp: f64,
+        z: f64,
+        theta1: f64,
+        theta2: f64,
+    ) -> (ToolPose, f64) {
+        let g = &m.module;
+        let module = ModulePose {
+            p: Vector3::new(x, yp, z),
+            alpha: 0.0,
+        };
+        let tool = crate::machine::tool_pose_eq26(&m.table, &module, theta1, theta2, m.tool_length);
+        let u = x + g.dx1;
+        let h = (g.l1 * g.l1 - (g.r_big1 - g.r_small1).powi(2) - u * u).sqrt();
+        (tool, h)
+    }
+
+    /// The leg-I path of a tool pose.
+    fn path_of<'a>(m: &'a Machine, pose: &ToolPose) -> Leg1Path<'a> {
+        let (sin_phi1, cos_phi1) = pose.phi1.sin_cos();
+        Leg1Path {
+            m,
+            w: tilt_frame_platform(&m.table, pose, m.tool_length),
+            sin_phi1,
+            cos_phi1,
+        }
+    }
+
     /// Table II's double root (IFToMM 2007): a platform point with yp = 0 and alpha = 0 has
     /// two leg-I postures, rho1 = zp +- h, at one theta1, where F has a double root. The
     /// machine's inverse kinematics of the tool pose built on it has both, each once (a
@@ -509,16 +583,8 @@ mod tests {
     #[test]
     fn both_postures_of_table_ii_s_double_root_are_found_once() {
         let m = Machine::default_verne();
-        let g = &m.module;
-        for (x, z, theta1, theta2) in [(30.0, 700.0, 0.2, 0.5), (-60.0, 820.0, -0.4, -2.0)] {
-            let module = ModulePose {
-                p: Vector3::new(x, 0.0, z),
-                alpha: 0.0,
-            };
-            let tool =
-                crate::machine::tool_pose_eq26(&m.table, &module, theta1, theta2, m.tool_length);
-            let u = x + g.dx1;
-            let h = (g.l1 * g.l1 - (g.r_big1 - g.r_small1).powi(2) - u * u).sqrt();
+        for (x, z, theta1, theta2) in TABLE_II_POSES {
+            let (tool, h) = table_ii_pose(&m, x, 0.0, z, theta1, theta2);
             let ik = machine_ik(&m, &tool, m.tool_length);
             assert!(ik.certificate.proved(), "{:?}", ik.certificate);
             let at: Vec<&MachineIkBranch> = ik
@@ -537,5 +603,157 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The seeds at sin(alpha) = 0 of Table II's double root are its two postures themselves,
+    /// rho1 = z +- h at the pose's theta1, before any polish. At the other angle, theta1 + pi
+    /// (alpha = pi), F vanishes too (yp = 0 there as well): its seeds are that platform point's
+    /// z' = 2 d_a - z plus and minus h' = sqrt(L1^2 - (R1 + r1)^2 - u^2), or z' twice where
+    /// leg I does not reach.
+    #[test]
+    fn the_alpha_zero_seeds_of_table_ii_s_double_root_are_its_postures() {
+        let m = Machine::default_verne();
+        let g = &m.module;
+        for (x, z, theta1, theta2) in TABLE_II_POSES {
+            let (tool, h) = table_ii_pose(&m, x, 0.0, z, theta1, theta2);
+            let f = theta1_equation(&m, &tool, m.tool_length);
+            let seeds = alpha_zero_seeds(&m, &tool, &path_of(&m, &tool), &f);
+            let u = x + g.dx1;
+            let h_pi = (g.l1 * g.l1 - (g.r_big1 + g.r_small1).powi(2) - u * u)
+                .max(0.0)
+                .sqrt();
+            let z_pi = 2.0 * m.table.d_a - z;
+            let expected = [
+                (theta1, z + h),
+                (theta1, z - h),
+                (theta1 + PI, z_pi + h_pi),
+                (theta1 + PI, z_pi - h_pi),
+            ];
+            assert_eq!(seeds.len(), 4, "{seeds:?}");
+            for ((th, rho1), (th_e, rho1_e)) in seeds.iter().zip(expected) {
+                assert!(
+                    wrap_angle(th - th_e).abs() < 1e-12 && (rho1 - rho1_e).abs() < 1e-8,
+                    "seed ({th}, {rho1}), expected ({th_e}, {rho1_e})"
+                );
+            }
+        }
+    }
+
+    /// Seeds at sin(alpha) = 0 only where F is small there: there F = yp^2 (R1 -+ r1)^2, so a
+    /// platform point yp off the plane y = 0 gives them while that value is below
+    /// [`ALPHA_ZERO_SEED_REL`] of F's largest coefficient (a quarter of it at alpha = 0), and
+    /// not at four times it; a generic pose gives none.
+    #[test]
+    fn alpha_zero_seeds_only_where_f_is_small() {
+        let m = Machine::default_verne();
+        let g = &m.module;
+        let (x, z, theta1, theta2) = TABLE_II_POSES[0];
+        let (tool, _) = table_ii_pose(&m, x, 0.0, z, theta1, theta2);
+        let f = theta1_equation(&m, &tool, m.tool_length);
+        let scale = f
+            .cos
+            .iter()
+            .chain(&f.sin)
+            .fold(0.0f64, |a, c| a.max(c.abs()));
+        let (rm, rp) = (g.r_big1 - g.r_small1, g.r_big1 + g.r_small1);
+        for (ratio, seeds_at_zero) in [(0.25, true), (4.0, false)] {
+            let yp = (ratio * ALPHA_ZERO_SEED_REL * scale).sqrt() / rm;
+            let (tool, _) = table_ii_pose(&m, x, yp, z, theta1, theta2);
+            let f = theta1_equation(&m, &tool, m.tool_length);
+            let seeds = alpha_zero_seeds(&m, &tool, &path_of(&m, &tool), &f);
+            let at_zero = seeds
+                .iter()
+                .filter(|s| wrap_angle(s.0 - theta1).abs() < 1e-12);
+            assert_eq!(
+                at_zero.count(),
+                if seeds_at_zero { 2 } else { 0 },
+                "{ratio}: {seeds:?}"
+            );
+            // At alpha = pi, F = yp^2 (R1 + r1)^2: seeds there too only if that is small.
+            let at_pi = (yp * rp).powi(2) <= ALPHA_ZERO_SEED_REL * scale;
+            assert_eq!(
+                seeds.len(),
+                2 * (seeds_at_zero as usize + at_pi as usize),
+                "{ratio}"
+            );
+        }
+        let generic = ToolPose {
+            tip: Vector3::new(20.0, -35.0, 40.0),
+            phi1: 0.3,
+            phi2: 0.2,
+        };
+        let f = theta1_equation(&m, &generic, m.tool_length);
+        assert!(alpha_zero_seeds(&m, &generic, &path_of(&m, &generic), &f).is_empty());
+    }
+
+    /// The leg-I postures of a generic tool pose, (theta1, rho1), from its branches.
+    fn postures(m: &Machine, pose: &ToolPose) -> Vec<(f64, f64)> {
+        let mut out: Vec<(f64, f64)> = Vec::new();
+        for b in machine_ik(m, pose, m.tool_length).iter() {
+            if !out.iter().any(|&(t, r)| t == b.theta1 && r == b.rho.x) {
+                out.push((b.theta1, b.rho.x));
+            }
+        }
+        out
+    }
+
+    /// What the polish of the seeds does to the certificate, with seeds injected as a failing
+    /// proof would give them: every proved seed found keeps it; a posture found only by a seed
+    /// no proof predicted, a proved seed that fails or that polishes to a posture more than
+    /// 1e-6 rad away make it unproved; allowed seeds count as expected, and one that fails
+    /// proves nothing missing.
+    #[test]
+    fn the_polish_of_the_seeds_keeps_the_certificate_only_when_the_proof_holds() {
+        let m = Machine::default_verne();
+        let pose = ToolPose {
+            tip: Vector3::new(20.0, -35.0, 40.0),
+            phi1: 0.3,
+            phi2: 0.2,
+        };
+        let path = path_of(&m, &pose);
+        let all = postures(&m, &pose);
+        assert!(all.len() >= 2, "{all:?}");
+        let (last, rest) = all.split_last().unwrap();
+        let nan = (f64::NAN, f64::NAN);
+        let off = (all[0].0 + 1e-3, all[0].1);
+        let run = |proved: &[(f64, f64)], allowed: &[(f64, f64)], others: &[(f64, f64)]| {
+            let mut certificate = Certificate::Double;
+            let found = polish_postures(&path, proved, allowed, others, &mut certificate);
+            let mut found: Vec<(f64, f64)> = found.iter().map(|q| (q.theta1, q.rho1)).collect();
+            found.sort_by(|a, b| a.0.total_cmp(&b.0));
+            assert_eq!(found.len(), all.len(), "{found:?} vs {all:?}");
+            for (a, b) in found.iter().zip(&all) {
+                assert!(
+                    (a.0 - b.0).abs() < 1e-9 && (a.1 - b.1).abs() < 1e-6,
+                    "{a:?} vs {b:?}"
+                );
+            }
+            certificate
+        };
+        let double = Certificate::Double;
+        let unproved = Certificate::Unproved;
+        assert_eq!(run(&all, &[], &[]), double);
+        assert_eq!(run(&all, &[], &all), double, "others that repeat the proof");
+        assert_eq!(
+            run(rest, &[], &[*last]),
+            unproved,
+            "a posture only others found"
+        );
+        assert_eq!(run(&all[..1], &all[1..], &[]), double, "the rest allowed");
+        assert_eq!(run(&all, &[nan], &[]), double, "an allowed seed that fails");
+        let mut failing = all.clone();
+        failing.push(nan);
+        assert_eq!(
+            run(&failing, &[], &[]),
+            unproved,
+            "a proved seed that fails"
+        );
+        let mut drifting = all.clone();
+        drifting.push(off);
+        assert_eq!(
+            run(&drifting, &[], &[]),
+            unproved,
+            "a proved seed that drifts"
+        );
     }
 }
