@@ -511,4 +511,98 @@ mod tests {
             assert!(residual_mm(&m.module, q, &b.rho) < 1e-6, "{q:?}");
         }
     }
+
+    /// The working joints of three poses away from condition (21), for the tests below: the
+    /// machine, and each pose with its sliders.
+    fn poses_and_sliders() -> (Machine, Vec<(ModulePose, Sliders)>) {
+        let m = Machine::default_verne();
+        let out = [
+            Vector3::new(-300.0, 0.0, 1100.0),
+            Vector3::new(-250.0, 120.0, 1050.0),
+            Vector3::new(-370.0, -60.0, 1100.0),
+        ]
+        .iter()
+        .map(|&p| {
+            let branches = crate::parallel_module::ik::solve(&m, &p);
+            let b = crate::parallel_module::ik::working(&branches).expect("a working branch");
+            (ModulePose { p, alpha: b.alpha }, b.rho)
+        })
+        .collect();
+        (m, out)
+    }
+
+    /// Away from Det = 0 the linear solution of (14) and (6) - (5) back-substituted at the
+    /// root's alpha is the pose the sliders were computed from (the factors are the other
+    /// route, taken only where Det ~ 0).
+    #[test]
+    fn back_substitution_gives_the_pose_of_the_sliders() {
+        let (m, poses) = poses_and_sliders();
+        for (pose, rho) in poses {
+            let elim = Elimination::new(&m.module, &rho);
+            let sc = pose.alpha.sin_cos();
+            let back = elim.back_substitute(&m.module, &rho, pose.alpha, sc);
+            let back = back.expect("Det is not zero at the working mode");
+            assert!((back.p - pose.p).norm() < 1e-6, "{back:?} vs {pose:?}");
+            assert_eq!(back.alpha, pose.alpha);
+        }
+    }
+
+    /// The back substitution refuses where |Det| is within FK_DET_REL of the sum of its
+    /// coefficients' sizes: at angles beside a zero of Det where it is half that, and at the
+    /// zero, not where it is twice that.
+    #[test]
+    fn back_substitution_refuses_within_its_tolerance_of_det_zero() {
+        let (m, poses) = poses_and_sliders();
+        let mut tried = 0;
+        for (_, rho) in poses {
+            let elim = Elimination::new(&m.module, &rho);
+            let d = &elim.det;
+            let scale = d.cos[0].abs() + d.cos[1].abs() + d.sin[1].abs();
+            for (s0, c0) in det_zeros(d) {
+                let alpha0 = s0.atan2(c0);
+                let slope = -d.cos[1] * s0 + d.sin[1] * c0;
+                assert!(
+                    elim.back_substitute(&m.module, &rho, alpha0, (s0, c0))
+                        .is_none()
+                );
+                for (k, refused) in [(0.5, true), (-0.5, true), (2.0, false), (-2.0, false)] {
+                    let alpha = alpha0 + k * FK_DET_REL * scale / slope;
+                    let sc = alpha.sin_cos();
+                    let det = d.eval_sc(sc.0, sc.1);
+                    let ratio = det / (FK_DET_REL * scale);
+                    assert!((ratio - k).abs() < 1e-3 * k.abs(), "{ratio} for {k}");
+                    let back = elim.back_substitute(&m.module, &rho, alpha, sc);
+                    assert_eq!(
+                        back.is_none(),
+                        refused,
+                        "Det at {k} of the tolerance: {back:?}"
+                    );
+                    tried += 1;
+                }
+            }
+        }
+        assert!(tried >= 8, "{tried}");
+    }
+
+    /// Sliders whose modes are simple, well-separated roots of F are proved in double
+    /// precision alone (no interval left ambiguous for the factors to resolve): Table III of
+    /// IFToMM 2007 and the working joints of the two poses off y = 0 above. The pose on y = 0
+    /// has two modes 1.3e-4 rad apart in alpha (docs/verne-geometry.md): that pair needs the
+    /// factors.
+    #[test]
+    fn simple_roots_are_proved_in_double_precision() {
+        let (m, poses) = poses_and_sliders();
+        let table3 = Vector3::new(674.0, 685.0, 250.0);
+        let rhos = poses.iter().map(|(_, rho)| *rho).chain([table3]);
+        for (k, rho) in rhos.enumerate() {
+            let modes = solve(&m, &rho);
+            assert!(!modes.is_empty(), "{rho:?}");
+            let expected = if k == 0 {
+                Certificate::Factored
+            } else {
+                Certificate::Double
+            };
+            assert_eq!(modes.certificate, expected, "{rho:?}: {modes:?}");
+        }
+    }
 }
