@@ -119,6 +119,21 @@ fn table3_fk_reproduces_paper_within_printed_precision() {
     }
 }
 
+/// The characteristic polynomial F(alpha) of rho = (674, 685, 250) mm has exactly the four real
+/// roots of the reference document's degree-8 polynomial in t = tan(alpha/2) (printed to 6
+/// decimals), and no others: the extra factors of the raw elimination are gone.
+#[test]
+fn table3_characteristic_has_the_reference_roots() {
+    let m = machine();
+    let f = fk::characteristic(&m.module, &Vector3::from(TABLE3_RHO));
+    let t: Vec<f64> = f.roots().iter().map(|a| (a / 2.0).tan()).collect();
+    let reference = [-0.113908, -0.070542, 1.276357, 4.455109];
+    assert_eq!(t.len(), reference.len(), "{t:?}");
+    for (got, want) in t.iter().zip(reference) {
+        assert!((got - want).abs() < 5e-7, "t = {got}, reference {want}");
+    }
+}
+
 #[test]
 fn table3_fk_matches_reference_document() {
     let m = machine();
