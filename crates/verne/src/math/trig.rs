@@ -296,7 +296,9 @@ impl Trig {
             .iter()
             .chain(&self.sin)
             .fold(0.0f64, |m, a| m.max(a.abs()));
-        if scale == 0.0 || !scale.is_finite() || !coef_err.is_finite() {
+        // `max` passes over a NaN: finiteness is tested on the coefficients themselves.
+        let finite = self.cos.iter().chain(&self.sin).all(|a| a.is_finite());
+        if scale == 0.0 || !finite || !coef_err.is_finite() {
             let mut out = Isolated::default();
             if certify && !(scale == 0.0 && coef_err == 0.0) {
                 // Not finite, or zero only within the coefficients' error: nothing is proved.
@@ -1164,6 +1166,240 @@ mod tests {
                 bits(&p.roots_sin_cos_baseline()),
                 "{p:?}"
             );
+        }
+    }
+
+    /// [`Trig::roots_certified`]'s promise, checked against the roots a form was built with:
+    /// the reported roots increase, lie outside the ambiguous intervals (closed, disjoint,
+    /// increasing), carry their own sine and cosine, and each is within `tol` of a true root;
+    /// every true root is reported within `tol` or lies in an ambiguous interval.
+    fn assert_certified(p: &Trig, coef_err: f64, want: &[f64], tol: f64) -> Isolated {
+        let iso = p.roots_certified(coef_err);
+        let inside = |x: f64| iso.ambiguous.iter().any(|&[lo, hi]| x >= lo && x <= hi);
+        for w in iso.roots.windows(2) {
+            assert!(w[0].x < w[1].x, "{iso:?}");
+        }
+        for w in iso.ambiguous.windows(2) {
+            assert!(w[0][1] < w[1][0], "{iso:?}");
+        }
+        for &[lo, hi] in &iso.ambiguous {
+            assert!(lo <= hi && lo >= -std::f64::consts::PI && hi <= std::f64::consts::PI);
+        }
+        for r in &iso.roots {
+            assert!(!inside(r.x), "{} in an ambiguous interval: {iso:?}", r.x);
+            let (sin, cos) = r.x.sin_cos();
+            assert!(
+                (r.sin - sin).abs() <= 1e-15 && (r.cos - cos).abs() <= 1e-15,
+                "{iso:?}"
+            );
+            assert!(
+                want.iter().any(|&w| circle_dist(r.x, w) < tol),
+                "{} is no root of {want:?}: {iso:?}",
+                r.x
+            );
+        }
+        for &w in want {
+            let w = if w > std::f64::consts::PI {
+                w - std::f64::consts::TAU
+            } else {
+                w
+            };
+            let found = iso.roots.iter().any(|r| circle_dist(r.x, w) < tol);
+            let at_pi = (std::f64::consts::PI - w.abs()) < tol;
+            let covered = inside(w) || (at_pi && (inside(-w) || inside(w)));
+            assert!(found || covered, "{w} missed: {iso:?}");
+        }
+        iso
+    }
+
+    /// Simple roots apart from each other (1e-3 apart, 1e-3 from pi) are all proved: none left
+    /// ambiguous, each reported once, within rounding.
+    #[test]
+    fn certified_isolation_proves_simple_roots() {
+        use std::f64::consts::PI;
+        for pairs in [
+            vec![(-2.9, -2.0), (-1.1, -0.3), (0.4, 1.2), (2.2, 3.0)],
+            vec![(0.7, 0.701), (-2.0, 2.5)],
+            vec![(-PI + 1e-3, PI - 1e-3), (0.1, 0.2)],
+        ] {
+            let want: Vec<f64> = pairs.iter().flat_map(|&(p, q)| [p, q]).collect();
+            for scale in [1.0, 3.7e21, 2e-30] {
+                let p = from_pairs(&pairs).scale(scale);
+                let iso = assert_certified(&p, 0.0, &want, 1e-12);
+                assert!(iso.ambiguous.is_empty(), "{pairs:?}: {iso:?}");
+                assert_eq!(iso.roots.len(), want.len(), "{pairs:?}: {iso:?}");
+            }
+        }
+    }
+
+    /// A root on a point of the isolation's grid (x = -pi + j pi / 16: alpha = 0, pi/2, pi) is
+    /// not proved in double precision: F there is within rounding of zero, and the grid
+    /// intervals on both sides are left ambiguous, one interval for both (the callers' factors
+    /// decide it). Roots elsewhere are proved.
+    #[test]
+    fn a_root_on_a_grid_point_is_left_ambiguous() {
+        use std::f64::consts::{FRAC_PI_2, PI};
+        let step = PI / 16.0;
+        for x in [0.0, FRAC_PI_2, -3.0 * step, PI] {
+            let pairs = [
+                (x, 1.0 + x + 0.5 * step),
+                (-2.0 + x + 0.5 * step, 2.0 + x + 0.3 * step),
+            ];
+            let want: Vec<f64> = pairs.iter().flat_map(|&(p, q)| [p, q]).collect();
+            let iso = assert_certified(&from_pairs(&pairs), 0.0, &want, 1e-12);
+            assert_eq!(iso.roots.len(), 3, "{x}: {iso:?}");
+            if x == PI {
+                assert_eq!(iso.ambiguous.len(), 2, "{x}: {iso:?}");
+                assert_eq!(iso.ambiguous[0], [-PI, -PI + step], "{iso:?}");
+                assert_eq!(iso.ambiguous[1], [PI - step, PI], "{iso:?}");
+            } else {
+                assert_eq!(iso.ambiguous.len(), 1, "{x}: {iso:?}");
+                let [lo, hi] = iso.ambiguous[0];
+                assert!(
+                    (lo - (x - step)).abs() < 1e-12 && (hi - (x + step)).abs() < 1e-12,
+                    "{x}: {iso:?}"
+                );
+            }
+        }
+    }
+
+    /// A double root (and a triple one) off the grid cannot be proved in double precision: it
+    /// lies in a narrow ambiguous interval, nothing is reported there, and the simple roots
+    /// elsewhere are proved. Four double roots (the most a form of degree 4 has) give four
+    /// intervals.
+    #[test]
+    fn a_double_root_is_left_ambiguous_in_a_narrow_interval() {
+        use std::f64::consts::PI;
+        for x in [0.3, -1.2, 1.0 + 1e-9, PI - 0.01] {
+            for pairs in [vec![(x, x), (2.0, -2.5)], vec![(x, x), (x, 2.0)]] {
+                let p = from_pairs(&pairs);
+                let want: Vec<f64> = pairs.iter().flat_map(|&(p, q)| [p, q]).collect();
+                let iso = assert_certified(&p, 0.0, &want, 1e-12);
+                assert_eq!(iso.ambiguous.len(), 1, "{pairs:?}: {iso:?}");
+                let [lo, hi] = iso.ambiguous[0];
+                assert!(hi - lo < 1e-3, "{pairs:?}: {iso:?}");
+                let simple = if pairs[1].0 == x { 1 } else { 2 };
+                assert_eq!(iso.roots.len(), simple, "{pairs:?}: {iso:?}");
+            }
+        }
+        let xs = [-2.5, -1.0, 0.5, 2.0];
+        let p = from_pairs(&xs.map(|x| (x, x)));
+        let iso = assert_certified(&p, 0.0, &xs, 1e-12);
+        assert!(iso.roots.is_empty(), "{iso:?}");
+        assert_eq!(iso.ambiguous.len(), 4, "{iso:?}");
+        for (&[lo, hi], x) in iso.ambiguous.iter().zip(xs) {
+            assert!(lo <= x && x <= hi && hi - lo < 1e-3, "{x}: {iso:?}");
+        }
+    }
+
+    /// Close pairs of roots, from 1e-3 apart down to 1e-14: each root is proved or lies in an
+    /// ambiguous interval (the promise the forward kinematics' factors build on), at the grid's
+    /// points, near pi and at random places.
+    #[test]
+    fn close_pairs_are_proved_or_left_ambiguous() {
+        use std::f64::consts::PI;
+        let mut uniform = crate::math::test_rng::lcg(0x5eed_0fc1_05e0);
+        let mut centres = vec![0.0, 0.1, PI / 16.0, -PI / 2.0, PI - 2e-3, -PI + 1e-4, PI];
+        for _ in 0..200 {
+            centres.push(PI * (2.0 * uniform() - 1.0));
+        }
+        let mut ambiguous = 0;
+        for &centre in &centres {
+            for k in 3..=14 {
+                let sep = 10f64.powi(-k) * (1.0 + uniform());
+                let pairs = [
+                    (centre - 0.5 * sep, centre + 0.5 * sep),
+                    (centre + 2.0, centre - 2.5),
+                ];
+                let want: Vec<f64> = pairs.iter().flat_map(|&(p, q)| [p, q]).collect();
+                // Rounding the coefficients moves a pair's roots by up to ~1e-16 / sep.
+                let tol = 1e-12 + 1e-15 / sep;
+                let iso = assert_certified(&from_pairs(&pairs), 0.0, &want, tol);
+                ambiguous += iso.ambiguous.len();
+            }
+        }
+        assert!(ambiguous > 0, "no pair was too close to prove");
+    }
+
+    /// The coefficients' own error counts: F = 1 - cos x + 1e-6 has no root, proved with
+    /// exact coefficients; with an error of 2e-6 in them, the exact polynomial might touch zero
+    /// at x = 0, which is then left ambiguous (and only there).
+    #[test]
+    fn the_coefficients_error_widens_what_is_not_proved() {
+        let p = Trig::linear(1.0 + 1e-6, -1.0, 0.0);
+        let exact = p.roots_certified(0.0);
+        assert!(
+            exact.roots.is_empty() && exact.ambiguous.is_empty(),
+            "{exact:?}"
+        );
+        let loose = p.roots_certified(2e-6);
+        assert!(loose.roots.is_empty(), "{loose:?}");
+        assert_eq!(loose.ambiguous.len(), 1, "{loose:?}");
+        let [lo, hi] = loose.ambiguous[0];
+        assert!(lo <= 0.0 && 0.0 <= hi && hi - lo < 0.5, "{loose:?}");
+        let p = from_pairs(&[(0.4, 1.2), (-2.0, 2.5)]);
+        let tight = p.roots_certified(1e-12);
+        assert!(
+            tight.ambiguous.is_empty() && tight.roots.len() == 4,
+            "{tight:?}"
+        );
+    }
+
+    /// Nothing is proved about a form that is not finite, or about the zero form when its
+    /// coefficients carry an error (or when that error is not finite): the whole circle is
+    /// ambiguous. The zero form with exact coefficients has no isolated root.
+    #[test]
+    fn certified_isolation_of_degenerate_forms() {
+        use std::f64::consts::PI;
+        let whole = [[-PI, PI]];
+        for (p, coef_err) in [
+            (Trig::default(), 1e-9),
+            (Trig::linear(f64::NAN, 1.0, 0.0), 0.0),
+            (Trig::linear(0.0, f64::INFINITY, 1.0), 0.0),
+            (from_pairs(&[(0.4, 1.2)]), f64::INFINITY),
+            (from_pairs(&[(0.4, 1.2)]), f64::NAN),
+        ] {
+            let iso = p.roots_certified(coef_err);
+            assert!(iso.roots.is_empty(), "{p:?}: {iso:?}");
+            assert_eq!(
+                iso.ambiguous.as_slice(),
+                &whole,
+                "{p:?} +- {coef_err}: {iso:?}"
+            );
+        }
+        let zero = Trig::default().roots_certified(0.0);
+        assert!(
+            zero.roots.is_empty() && zero.ambiguous.is_empty(),
+            "{zero:?}"
+        );
+    }
+
+    /// [`Trig::roots_certified`] (the AVX2 build where the processor has it) and the baseline
+    /// build of the same isolation give the same roots and intervals, bit for bit.
+    #[test]
+    fn certified_builds_agree() {
+        let mut uniform = crate::math::test_rng::lcg(0x0ce7_1f1e_d000_0001);
+        let mut unit = || uniform() * 2.0 - 1.0;
+        for _ in 0..2000 {
+            let (x, sep) = (3.0 * unit(), 1e-9 * (1.0 + unit()));
+            for p in [
+                random_form(&mut unit),
+                from_pairs(&[(x, x + sep), (x - 2.0, 0.5 * unit())]),
+            ] {
+                let err = 1e-14 * (1.0 + unit());
+                let a = p.roots_certified(err);
+                let b = p.isolate_built::<false>(err, true);
+                let bits = |i: &Isolated| -> (Vec<[u64; 3]>, Vec<[u64; 2]>) {
+                    (
+                        i.roots
+                            .iter()
+                            .map(|r| [r.x, r.sin, r.cos].map(f64::to_bits))
+                            .collect(),
+                        i.ambiguous.iter().map(|a| a.map(f64::to_bits)).collect(),
+                    )
+                };
+                assert_eq!(bits(&a), bits(&b), "{p:?}");
+            }
         }
     }
 }
