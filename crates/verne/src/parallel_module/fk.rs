@@ -507,8 +507,17 @@ mod tests {
         let points = fixed_alpha_points(&m.module, &b.rho, 0.0, (0.0, 1.0));
         assert_eq!(points.len(), 2, "{points:?}");
         assert!(points.iter().any(|q| (q.p - p).norm() < 1e-6), "{points:?}");
+        assert!((points[0].p - points[1].p).norm() > 1.0, "{points:?}");
         for q in &points {
             assert!(residual_mm(&m.module, q, &b.rho) < 1e-6, "{q:?}");
+        }
+        // 1e-10 rad away the planes nearly share the line: their smallest singular value is
+        // within FK_DET_REL of the largest, so the line is used, not a point divided by it.
+        let alpha = 1e-10;
+        let near = fixed_alpha_points(&m.module, &b.rho, alpha, alpha.sin_cos());
+        assert_eq!(near.len(), 2, "{near:?}");
+        for (q, q0) in near.iter().zip(&points) {
+            assert!((q.p - q0.p).norm() < 1e-6, "{near:?} vs {points:?}");
         }
     }
 
