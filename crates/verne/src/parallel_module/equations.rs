@@ -64,7 +64,9 @@ pub fn residuals(g: &ModuleGeometry, pose: &ModulePose, rho: &Sliders) -> Vector
     Vector4::from_fn(|i, _| v[i].norm_squared() - l[i] * l[i])
 }
 
-/// The largest residual expressed as a length error along its rod, |f| / (2 L) (mm).
+/// The largest residual expressed as a length error along its rod, |f| / (2 L) (mm); infinite
+/// when a pose or sliders that are not finite make one NaN, so that no such pose passes a
+/// residual test.
 pub fn residual_mm(g: &ModuleGeometry, pose: &ModulePose, rho: &Sliders) -> f64 {
     let (s, c) = pose.alpha.sin_cos();
     residual_mm_sc(g, pose, rho, s, c)
@@ -76,8 +78,18 @@ pub fn residual_mm_sc(g: &ModuleGeometry, pose: &ModulePose, rho: &Sliders, s: f
     let v = rod_vectors_sc(g, pose, rho, s, c);
     let l = rod_lengths(g);
     (0..4).fold(0.0f64, |m, i| {
-        m.max(((v[i].norm_squared() - l[i] * l[i]) / (2.0 * l[i])).abs())
+        worse(
+            m,
+            ((v[i].norm_squared() - l[i] * l[i]) / (2.0 * l[i])).abs(),
+        )
     })
+}
+
+/// The larger of two residuals, a NaN counting as infinite: `f64::max` passes over a NaN, and
+/// a pose or sliders that are not finite would then pass as a solution with residual 0.
+#[inline(always)]
+fn worse(m: f64, e: f64) -> f64 {
+    m.max(if e.is_nan() { f64::INFINITY } else { e })
 }
 
 /// Derivatives of each rod vector with respect to alpha.
@@ -166,7 +178,8 @@ pub fn polish_pose_from(
 ) -> (ModulePose, f64, (f64, f64)) {
     use crate::tolerance::{NEWTON_MAX_ITER, NEWTON_STEP_STOP};
     let l = rod_lengths(g);
-    let as_mm = |f: &Vector4<f64>| (0..4).fold(0.0f64, |m, i| m.max((f[i] / (2.0 * l[i])).abs()));
+    let as_mm =
+        |f: &Vector4<f64>| (0..4).fold(0.0f64, |m, i| worse(m, (f[i] / (2.0 * l[i])).abs()));
     let mut cur = start;
     let mut sc = (s, c);
     let (mut f, mut a) = residuals_jacobian_at(g, &cur, rho, s, c);
@@ -309,6 +322,33 @@ mod tests {
             let fd = (residuals(&g, &pose, &plus) - residuals(&g, &pose, &minus)) / (2.0 * h);
             for i in 0..4 {
                 assert!((fd[i] - b[(i, j)]).abs() < 1e-4 * (1.0 + b[(i, j)].abs()));
+            }
+        }
+    }
+
+    /// A pose or sliders with a NaN or an infinity never pass a residual test: the residual is
+    /// infinite (it was 0 for a NaN, which `f64::max` passed over), and the polish from such a
+    /// start reports an infinite residual, not a solution.
+    #[test]
+    fn a_pose_that_is_not_finite_has_an_infinite_residual() {
+        let m = crate::spec::Machine::default_verne();
+        let g = &m.module;
+        let p = Vector3::new(-300.0, 0.0, 1100.0);
+        let branches = crate::parallel_module::ik::solve(&m, &p);
+        let b = crate::parallel_module::ik::working(&branches).expect("a working branch");
+        let good = ModulePose { p, alpha: b.alpha };
+        assert!(residual_mm(g, &good, &b.rho) < 1e-9);
+        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            for k in 0..7 {
+                let (mut pose, mut rho) = (good, b.rho);
+                match k {
+                    0..=2 => pose.p[k] = bad,
+                    3 => pose.alpha = bad,
+                    _ => rho[k - 4] = bad,
+                }
+                assert_eq!(residual_mm(g, &pose, &rho), f64::INFINITY, "{bad} at {k}");
+                let (_, residual) = polish_pose_with_residual(g, pose, &rho);
+                assert_eq!(residual, f64::INFINITY, "{bad} at {k}");
             }
         }
     }

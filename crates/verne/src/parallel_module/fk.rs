@@ -328,11 +328,33 @@ fn solve_built<const AVX2: bool>(m: &Machine, rho: &Sliders) -> FkModes {
         );
         out.weaken(Certificate::from(resolution));
     }
-    // Where condition (21) fails (Det = 0), a real solution forces b = 0 there and F then has
-    // (at least) a double root, F = 4 b^2 (Q^2 + delta^2 (R1^2 + r1^2 - 2 R1 r1 c)) >= 0 (it
-    // happens on a whole plane: L2 = L3, rho2 = rho3, alpha = 0, y_p = 0). Those (at most two)
-    // angles are tried directly on the four spheres, keeping only points that already solve
-    // them: a cross-check of the proof, which finds these modes as roots of the factors.
+    det_zero_starts(g, rho, &elim, &undecided, &mut allowed, &mut others);
+    polish_modes(m, rho, &proved, &allowed, &others, &mut out);
+    out.sort_by(|a, b| {
+        a.pose
+            .alpha
+            .total_cmp(&b.pose.alpha)
+            .then(a.config.cmp(&b.config))
+    });
+    out.mark_unproved(|m| &mut m.verdict);
+    out
+}
+
+/// Where condition (21) fails (Det = 0), a real solution forces b = 0 there and F then has (at
+/// least) a double root, F = 4 b^2 (Q^2 + delta^2 (R1^2 + r1^2 - 2 R1 r1 c)) >= 0 (it happens
+/// on a whole plane: L2 = L3, rho2 = rho3, alpha = 0, y_p = 0). Those (at most two) angles are
+/// tried directly on the four spheres, keeping only points that already solve them: a
+/// cross-check of the proof, which finds these modes as roots of the factors. A point inside an
+/// interval double-double left `undecided` goes to `allowed`, any other to `others`.
+#[inline(always)]
+fn det_zero_starts(
+    g: &ModuleGeometry,
+    rho: &Sliders,
+    elim: &Elimination,
+    undecided: &[[f64; 2]],
+    allowed: &mut ArrayVec<ProvedStart, 40>,
+    others: &mut ArrayVec<ProvedStart, 40>,
+) {
     let b_scale = elim.b.cos[0].abs() + elim.b.sin[1].abs();
     for sc in det_zeros(&elim.det) {
         // F = 4 b^2 (Q^2 + delta^2 N) > 0 there unless b = 0: no solution at this alpha.
@@ -348,14 +370,36 @@ fn solve_built<const AVX2: bool>(m: &Machine, rho: &Sliders) -> FkModes {
         });
         for pose in fixed_alpha_points(g, rho, alpha, sc) {
             if residual_mm(g, &pose, rho) <= ACCEPT_RESIDUAL_MM {
-                let to = if expected { &mut allowed } else { &mut others };
+                let to = if expected {
+                    &mut *allowed
+                } else {
+                    &mut *others
+                };
                 let _ = to.try_push(ProvedStart { pose, sc });
             }
         }
     }
+}
+
+/// The modes polished (Newton on eqs. (3)-(6)) from three lists of starts, duplicates merged,
+/// into `out`: `proved`, one per proved root of F, each of which must polish within
+/// [`ROOT_POLISH_RAD`] of its alpha; `allowed`, starts that hold at most one mode each and may
+/// fail; `others`, starts no proof predicts. The certificate becomes
+/// [`Certificate::Unproved`] when a proved start fails or drifts, when a mode comes from
+/// `others` alone, or when there are more modes than the list holds.
+#[inline(always)]
+fn polish_modes(
+    m: &Machine,
+    rho: &Sliders,
+    proved: &[ProvedStart],
+    allowed: &[ProvedStart],
+    others: &[ProvedStart],
+    out: &mut FkModes,
+) {
+    let g = &m.module;
     let n_proved = proved.len();
     let n_expected = n_proved + allowed.len();
-    for (k, start) in proved.iter().chain(&allowed).chain(&others).enumerate() {
+    for (k, start) in proved.iter().chain(allowed).chain(others).enumerate() {
         let (pose, residual, (s, c)) = polish_pose_from(g, start.pose, start.sc, rho);
         if residual > ACCEPT_RESIDUAL_MM {
             if k < n_proved {
@@ -394,14 +438,6 @@ fn solve_built<const AVX2: bool>(m: &Machine, rho: &Sliders) -> FkModes {
             verdict,
         });
     }
-    out.sort_by(|a, b| {
-        a.pose
-            .alpha
-            .total_cmp(&b.pose.alpha)
-            .then(a.config.cmp(&b.config))
-    });
-    out.mark_unproved(|m| &mut m.verdict);
-    out
 }
 
 /// The machine's assembly mode: the feasible one (the smallest |alpha| if several are).
@@ -613,5 +649,149 @@ mod tests {
             };
             assert_eq!(modes.certificate, expected, "{rho:?}: {modes:?}");
         }
+    }
+
+    /// The machine with legs II and III alike (L3 = L2), where condition (21) fails on a
+    /// plane, and the sliders of P = (-300, 0, 1100) on it (rho2 = rho3, alpha = 0).
+    fn symmetric_plane() -> (Machine, Vector3<f64>, Sliders) {
+        let text = crate::spec::DEFAULT_MACHINE_TOML.replace("L3 = 950.46", "L3 = 950.30");
+        let m = Machine::from_toml_str(&text, "symmetric").unwrap();
+        let p = Vector3::new(-300.0, 0.0, 1100.0);
+        let branches = crate::parallel_module::ik::solve(&m, &p);
+        let rho = crate::parallel_module::ik::working(&branches)
+            .expect("a working branch")
+            .rho;
+        (m, p, rho)
+    }
+
+    /// The cross-check at the zeros of Det: on the plane where condition (21) fails, the points
+    /// at alpha = 0 (b = 0 there) are starts, the pose among them; they go to `allowed` when
+    /// alpha = 0 is in an interval double-double left undecided (or within 1e-12 rad of one of
+    /// its ends), to `others` otherwise. Where b is not zero at the zeros of Det, none.
+    #[test]
+    fn starts_at_the_zeros_of_det() {
+        let (m, p, rho) = symmetric_plane();
+        let elim = Elimination::new(&m.module, &rho);
+        let at_zero =
+            |starts: &[ProvedStart]| starts.iter().filter(|st| st.pose.alpha == 0.0).count();
+        for (undecided, expected) in [
+            (vec![], false),
+            (vec![[-1e-3, 1e-3]], true),
+            (vec![[5e-13, 0.1]], true),
+            (vec![[-0.1, -5e-13]], true),
+            (vec![[-0.2, -0.1], [1e-9, 0.1]], false),
+            (vec![[-3.0, -1e-9]], false),
+        ] {
+            let (mut allowed, mut others) = (ArrayVec::new(), ArrayVec::new());
+            det_zero_starts(
+                &m.module,
+                &rho,
+                &elim,
+                &undecided,
+                &mut allowed,
+                &mut others,
+            );
+            let (to, not) = if expected {
+                (&allowed, &others)
+            } else {
+                (&others, &allowed)
+            };
+            assert_eq!(at_zero(to), 2, "{undecided:?}: {allowed:?} {others:?}");
+            assert_eq!(at_zero(not), 0, "{undecided:?}: {allowed:?} {others:?}");
+            assert!(to.iter().any(|st| (st.pose.p - p).norm() < 1e-6), "{to:?}");
+            for st in allowed.iter().chain(&others) {
+                assert!(residual_mm(&m.module, &st.pose, &rho) <= ACCEPT_RESIDUAL_MM);
+                let (sin, cos) = st.pose.alpha.sin_cos();
+                assert!((st.sc.0 - sin).abs() < 1e-15 && (st.sc.1 - cos).abs() < 1e-15);
+            }
+        }
+        // The default machine (L3 != L2), the same sliders: b = L3^2 - L2^2 at alpha = 0.
+        let m = Machine::default_verne();
+        let elim = Elimination::new(&m.module, &rho);
+        assert_eq!(det_zeros(&elim.det).len(), 2);
+        let (mut allowed, mut others) = (ArrayVec::new(), ArrayVec::new());
+        det_zero_starts(&m.module, &rho, &elim, &[], &mut allowed, &mut others);
+        assert!(allowed.is_empty() && others.is_empty(), "{others:?}");
+    }
+
+    /// What the polish of the starts does to the certificate, with starts injected as a failing
+    /// proof would give them: every proved start found keeps it; a mode found only from a
+    /// start no proof predicted, a proved start that fails or that polishes to a mode more than
+    /// 1e-6 rad away make it unproved; allowed starts count as expected, and one that fails
+    /// proves nothing missing. A start a whole turn away polishes to the mode's alpha in
+    /// (-pi, pi].
+    #[test]
+    fn the_polish_of_the_starts_keeps_the_certificate_only_when_the_proof_holds() {
+        let (m, poses) = poses_and_sliders();
+        let rho = poses[1].1;
+        let modes = solve(&m, &rho);
+        assert!(modes.len() >= 2 && modes.certificate == Certificate::Double);
+        let start = |pose: ModulePose| ProvedStart {
+            pose,
+            sc: pose.alpha.sin_cos(),
+        };
+        let all: Vec<ProvedStart> = modes.iter().map(|md| start(md.pose)).collect();
+        let (last, rest) = all.split_last().unwrap();
+        let failing = start(ModulePose {
+            p: Vector3::new(f64::NAN, 0.0, 0.0),
+            alpha: f64::NAN,
+        });
+        let drifting = start(ModulePose {
+            alpha: modes[0].pose.alpha + 1e-3,
+            ..modes[0].pose
+        });
+        let turned = start(ModulePose {
+            alpha: modes[0].pose.alpha + 2.0 * std::f64::consts::PI,
+            ..modes[0].pose
+        });
+        let run = |proved: &[ProvedStart], allowed: &[ProvedStart], others: &[ProvedStart]| {
+            let mut out = FkModes::new();
+            polish_modes(&m, &rho, proved, allowed, others, &mut out);
+            out.sort_by(|a, b| a.pose.alpha.total_cmp(&b.pose.alpha));
+            assert_eq!(out.len(), modes.len(), "{out:?} vs {modes:?}");
+            for (a, b) in out.iter().zip(modes.iter()) {
+                assert!(
+                    (a.pose.p - b.pose.p).norm() < 1e-6
+                        && (a.pose.alpha - b.pose.alpha).abs() < 1e-9,
+                    "{a:?} vs {b:?}"
+                );
+                assert_eq!((a.config, a.verdict), (b.config, b.verdict));
+            }
+            out.certificate
+        };
+        let with = |extra: ProvedStart| {
+            let mut v = all.clone();
+            v.push(extra);
+            v
+        };
+        let (double, unproved) = (Certificate::Double, Certificate::Unproved);
+        assert_eq!(run(&all, &[], &[]), double);
+        assert_eq!(run(&all, &[], &all), double, "others that repeat the proof");
+        assert_eq!(
+            run(rest, &[], &[*last]),
+            unproved,
+            "a mode only others found"
+        );
+        assert_eq!(run(&all[..1], &all[1..], &[]), double, "the rest allowed");
+        assert_eq!(
+            run(&all, &[failing], &[]),
+            double,
+            "an allowed start that fails"
+        );
+        assert_eq!(
+            run(&with(failing), &[], &[]),
+            unproved,
+            "a proved start that fails"
+        );
+        assert_eq!(
+            run(&with(drifting), &[], &[]),
+            unproved,
+            "a proved start that drifts"
+        );
+        assert_eq!(
+            run(&[turned], &all[1..], &[]),
+            double,
+            "a start a turn away"
+        );
     }
 }
