@@ -1402,4 +1402,78 @@ mod tests {
             }
         }
     }
+
+    /// `harmonic_bound(order)` bounds |p^(order)| over the circle and is attained by a single
+    /// harmonic a cos kx + b sin kx (k^order sqrt(a^2 + b^2) at its crest, to 1e-12); for sums
+    /// of harmonics it covers every sampled value.
+    #[test]
+    fn harmonic_bound_is_the_largest_derivative() {
+        let mut uniform = crate::math::test_rng::lcg(0x4a12_b0c5_0000_0007);
+        let mut unit = || uniform() * 2.0 - 1.0;
+        for k in 1..=MAX_HARMONIC {
+            let (a, b) = (unit(), unit());
+            let mut p = Trig::default();
+            p.cos[k] = a;
+            p.sin[k] = b;
+            let mut d = p;
+            for order in 0..=2 {
+                // p^(order) = k^order sqrt(a^2 + b^2) cos(k x - atan2(b, a) + order pi / 2).
+                let crest = (b.atan2(a) - order as f64 * std::f64::consts::FRAC_PI_2) / k as f64;
+                let bound = p.harmonic_bound(order);
+                let top = d.eval(crest).abs();
+                let exact = (k as f64).powi(order) * a.hypot(b);
+                assert!((top - exact).abs() <= 1e-12 * exact, "k {k}, order {order}");
+                assert!(
+                    bound >= top && bound <= exact * (1.0 + 1e-11),
+                    "k {k}, order {order}"
+                );
+                d = d.derivative();
+            }
+        }
+        for _ in 0..200 {
+            let mut p = random_form(&mut unit);
+            p.cos[0] = 0.0;
+            let mut d = p;
+            for order in 0..=2 {
+                let bound = p.harmonic_bound(order);
+                for j in 0..100 {
+                    let x = -3.2 + 0.064 * j as f64;
+                    assert!(d.eval(x).abs() <= bound, "order {order} at {x}: {p:?}");
+                }
+                d = d.derivative();
+            }
+        }
+    }
+
+    /// `eval_error` bounds the rounding of the isolation's evaluation of p (the harmonics by
+    /// their recurrences, then the sum) against the same evaluation in double-double, for
+    /// random forms and points.
+    #[test]
+    fn eval_error_bounds_the_evaluation() {
+        use crate::math::dd::Dd;
+        let mut uniform = crate::math::test_rng::lcg(0x3e7a_1e44_0000_0003);
+        let mut unit = || uniform() * 2.0 - 1.0;
+        let mut worst = 0.0f64;
+        for _ in 0..300 {
+            let p = random_form(&mut unit).scale(10f64.powi((8.0 * unit()) as i32));
+            for _ in 0..50 {
+                let x = std::f64::consts::PI * unit();
+                let (s1, c1) = x.sin_cos();
+                let (c, s) = harmonics(s1, c1);
+                let got = dot_harmonics(&p, &c, &s);
+                let (dc1, ds1) = (Dd::from(c1), Dd::from(s1));
+                let (mut ck, mut sk) = (dc1, ds1);
+                let mut exact = Dd::from(p.cos[0]);
+                for k in 1..=MAX_HARMONIC {
+                    exact = exact + ck * p.cos[k] + sk * p.sin[k];
+                    (ck, sk) = (ck * dc1 - sk * ds1, sk * dc1 + ck * ds1);
+                }
+                let err = (Dd::from(got) - exact).abs().to_f64();
+                let bound = p.eval_error();
+                assert!(err <= bound, "{err} > {bound} at {x}: {p:?}");
+                worst = worst.max(err / bound);
+            }
+        }
+        assert!(worst > 0.0, "no rounding seen");
+    }
 }
