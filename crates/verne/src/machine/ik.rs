@@ -661,14 +661,23 @@ mod tests {
             let (tool, _) = table_ii_pose(&m, x, yp, z, theta1, theta2);
             let f = theta1_equation(&m, &tool, m.tool_length);
             let seeds = alpha_zero_seeds(&m, &tool, &path_of(&m, &tool), &f);
-            let at_zero = seeds
+            let at_zero: Vec<f64> = seeds
                 .iter()
-                .filter(|s| wrap_angle(s.0 - theta1).abs() < 1e-12);
+                .filter(|s| wrap_angle(s.0 - theta1).abs() < 1e-12)
+                .map(|s| s.1)
+                .collect();
             assert_eq!(
-                at_zero.count(),
+                at_zero.len(),
                 if seeds_at_zero { 2 } else { 0 },
                 "{ratio}: {seeds:?}"
             );
+            // Off y = 0 the seeds are rho1 = z +- h with h^2 = L1^2 - (R1 - r1)^2 - u^2 - yp^2
+            // (eq. (10) of IFToMM 2007 at alpha = 0): yp counts, by about 1e-6 mm here.
+            let u = x + g.dx1;
+            let h = (g.l1 * g.l1 - rm * rm - u * u - yp * yp).sqrt();
+            for (rho1, expected) in at_zero.iter().zip([z + h, z - h]) {
+                assert!((rho1 - expected).abs() < 1e-9, "{rho1} vs {expected}");
+            }
             // At alpha = pi, F = yp^2 (R1 + r1)^2: seeds there too only if that is small.
             let at_pi = (yp * rp).powi(2) <= ALPHA_ZERO_SEED_REL * scale;
             assert_eq!(
