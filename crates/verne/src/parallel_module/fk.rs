@@ -599,7 +599,10 @@ mod tests {
     fn back_substitution_refuses_within_its_tolerance_of_det_zero() {
         let (m, poses) = poses_and_sliders();
         let mut tried = 0;
-        for (_, rho) in poses {
+        // Table III's sliders too: rho2 - rho3 = 435 mm makes Det's cosine terms a third of
+        // the sum of its coefficients' sizes.
+        let table3 = Vector3::new(674.0, 685.0, 250.0);
+        for rho in poses.iter().map(|(_, rho)| *rho).chain([table3]) {
             let elim = Elimination::new(&m.module, &rho);
             let d = &elim.det;
             let scale = d.cos[0].abs() + d.cos[1].abs() + d.sin[1].abs();
@@ -626,7 +629,7 @@ mod tests {
                 }
             }
         }
-        assert!(tried >= 8, "{tried}");
+        assert!(tried >= 12, "{tried}");
     }
 
     /// Sliders whose modes are simple, well-separated roots of F are proved in double
@@ -714,11 +717,62 @@ mod tests {
         assert!(allowed.is_empty() && others.is_empty(), "{others:?}");
     }
 
+    /// 1e-7 mm off that plane (rho3 moved by -+1e-7 mm) Det's zero leaves alpha = 0 by about
+    /// 4e-11 rad and b there is about 1e-4 mm^2, still within DET_ZERO_B_REL of its
+    /// coefficients: the points there, within 1e-7 mm of solving the equations, are starts,
+    /// in `allowed` when an undecided interval holds that zero or ends within 1e-12 rad of it.
+    #[test]
+    fn starts_at_a_zero_of_det_next_to_the_plane() {
+        let (m, p, on_plane) = symmetric_plane();
+        for eps in [1e-7, -1e-7] {
+            let rho = Vector3::new(on_plane.x, on_plane.y, on_plane.z + eps);
+            let elim = Elimination::new(&m.module, &rho);
+            let alpha0 = det_zeros(&elim.det)
+                .iter()
+                .map(|&(s, c)| s.atan2(c))
+                .find(|a| a.abs() < 1e-6)
+                .expect("a zero of Det next to alpha = 0");
+            assert!(alpha0.abs() > 1e-11, "{alpha0}");
+            let at_zero = |starts: &[ProvedStart]| {
+                starts
+                    .iter()
+                    .filter(|st| (st.pose.alpha - alpha0).abs() < 1e-15)
+                    .count()
+            };
+            for (undecided, expected) in [
+                (vec![], false),
+                (vec![[alpha0 + 5e-13, 0.1]], true),
+                (vec![[-0.1, alpha0 - 5e-13]], true),
+                (vec![[alpha0 - 1e-11, alpha0 + 1e-11]], true),
+                (vec![[alpha0 + 2e-12, 0.1]], false),
+                (vec![[-0.1, alpha0 - 2e-12]], false),
+            ] {
+                let (mut allowed, mut others) = (ArrayVec::new(), ArrayVec::new());
+                det_zero_starts(
+                    &m.module,
+                    &rho,
+                    &elim,
+                    &undecided,
+                    &mut allowed,
+                    &mut others,
+                );
+                let (to, not) = if expected {
+                    (&allowed, &others)
+                } else {
+                    (&others, &allowed)
+                };
+                let case = format!("{eps}, {undecided:?}: {allowed:?} {others:?}");
+                assert_eq!((at_zero(to), at_zero(not)), (2, 0), "{case}");
+                assert!(to.iter().any(|st| (st.pose.p - p).norm() < 1e-6), "{case}");
+            }
+        }
+    }
+
     /// What the polish of the starts does to the certificate, with starts injected as a failing
     /// proof would give them: every proved start found keeps it; a mode found only from a
     /// start no proof predicted, a proved start that fails or that polishes to a mode more than
     /// 1e-6 rad away make it unproved; allowed starts count as expected, and one that fails
-    /// proves nothing missing. A start a whole turn away polishes to the mode's alpha in
+    /// or drifts proves nothing missing. A start a whole turn away polishes to the mode's alpha in
     /// (-pi, pi].
     #[test]
     fn the_polish_of_the_starts_keeps_the_certificate_only_when_the_proof_holds() {
@@ -778,6 +832,13 @@ mod tests {
             double,
             "an allowed start that fails"
         );
+        let mut allowed_drifting = all[1..].to_vec();
+        allowed_drifting[0] = start(ModulePose {
+            alpha: modes[1].pose.alpha + 1e-3,
+            ..modes[1].pose
+        });
+        let drift = run(&all[..1], &allowed_drifting, &[]);
+        assert_eq!(drift, double, "an allowed start that drifts");
         assert_eq!(
             run(&with(failing), &[], &[]),
             unproved,
