@@ -1199,11 +1199,9 @@ mod tests {
             );
         }
         for &w in want {
-            let w = if w > std::f64::consts::PI {
-                w - std::f64::consts::TAU
-            } else {
-                w
-            };
+            // In [-pi, pi): the ambiguous intervals are.
+            let w =
+                (w + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
             let found = iso.roots.iter().any(|r| circle_dist(r.x, w) < tol);
             let at_pi = (std::f64::consts::PI - w.abs()) < tol;
             let covered = inside(w) || (at_pi && (inside(-w) || inside(w)));
