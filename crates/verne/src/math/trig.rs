@@ -269,7 +269,22 @@ impl Trig {
     pub(crate) fn roots_sin_cos_built<const AVX2: bool>(
         &self,
     ) -> ArrayVec<TrigRoot, MAX_TRIG_ROOTS> {
-        self.isolate_built::<AVX2>(0.0, false).roots
+        let mut roots = self.isolate_built::<AVX2>(0.0, false).roots;
+        // A root on a grid point is found by the charts of both intervals it ends, and one at
+        // pi by the last interval as well as at -pi by the first: each once, at -pi for +-pi.
+        for r in roots.iter_mut() {
+            if r.x >= std::f64::consts::PI {
+                r.x -= std::f64::consts::TAU;
+            }
+        }
+        roots.sort_by(|a, b| a.x.total_cmp(&b.x));
+        let mut out: ArrayVec<TrigRoot, MAX_TRIG_ROOTS> = ArrayVec::new();
+        for r in roots {
+            if out.last().is_none_or(|last| r.x - last.x > SAME_ROOT_RAD) {
+                out.push(r);
+            }
+        }
+        out
     }
 
     /// Every real root in [-pi, pi] that can be proved, and the intervals where none can be
@@ -420,6 +435,10 @@ pub struct Isolated {
 /// Most roots [`Trig::roots`] returns: 2 [`MAX_HARMONIC`] simple roots, plus candidates at
 /// near-double roots.
 pub const MAX_TRIG_ROOTS: usize = 32;
+
+/// Two roots of [`Trig::roots`] closer than this (rad) are one: the same root found from the
+/// two grid intervals it ends (far below the separation of roots the charts tell apart).
+const SAME_ROOT_RAD: f64 = 1e-12;
 
 /// Grid of the root isolation: x_j = -pi + j pi / 16, j = 0..32.
 const GRID: usize = 32;
@@ -1036,9 +1055,13 @@ mod tests {
     }
 
     /// Every expected root is within `tol` of a reported one, and every reported one of an
-    /// expected one.
+    /// expected one; the reported roots lie in [-pi, pi] and increase.
     fn assert_roots(p: &Trig, want: &[f64], tol: f64) {
         let got = p.roots();
+        // In [-pi, pi], increasing, as `roots` promises.
+        let pi = std::f64::consts::PI;
+        assert!(got.iter().all(|x| (-pi..=pi).contains(x)), "{got:?}");
+        assert!(got.windows(2).all(|w| w[0] < w[1]), "{got:?}");
         for &w in want {
             assert!(
                 got.iter().any(|&g| circle_dist(g, w) < tol),
