@@ -1,7 +1,8 @@
 //! Reference results of the parallel module: Table III of IFToMM 2007 (forward kinematics of
-//! rho = (674, 685, 250) mm), and the reference tables of docs/verne-geometry.md computed with the
-//! default geometry (inverse kinematics of P = (-240, -86, 1000) mm, the y_p = 0 special case
-//! P = (-300, 0, 1100) mm and the forward kinematics of its working joints).
+//! rho = (674, 685, 250) mm), and the reference tables of shared/reference/verne-geometry.md
+//! computed with the default geometry (inverse kinematics of P = (-240, -86, 1000) mm, the
+//! y_p = 0 special case P = (-300, 0, 1100) mm and the forward kinematics of its working
+//! joints).
 //!
 //! Every expected value below is copied from the paper or from the reference document, never
 //! produced by the code under test.
