@@ -667,6 +667,24 @@ mod tests {
         (m, p, rho)
     }
 
+    /// The starts [`det_zero_starts`] gives for `undecided`, as (the list `expected` names,
+    /// `allowed` when true, and the other list).
+    fn starts_in(
+        m: &Machine,
+        rho: &Sliders,
+        undecided: &[[f64; 2]],
+        expected: bool,
+    ) -> (ArrayVec<ProvedStart, 40>, ArrayVec<ProvedStart, 40>) {
+        let elim = Elimination::new(&m.module, rho);
+        let (mut allowed, mut others) = (ArrayVec::new(), ArrayVec::new());
+        det_zero_starts(&m.module, rho, &elim, undecided, &mut allowed, &mut others);
+        if expected {
+            (allowed, others)
+        } else {
+            (others, allowed)
+        }
+    }
+
     /// The cross-check at the zeros of Det: on the plane where condition (21) fails, the points
     /// at alpha = 0 (b = 0 there) are starts, the pose among them; they go to `allowed` when
     /// alpha = 0 is in an interval double-double left undecided (or within 1e-12 rad of one of
@@ -674,7 +692,6 @@ mod tests {
     #[test]
     fn starts_at_the_zeros_of_det() {
         let (m, p, rho) = symmetric_plane();
-        let elim = Elimination::new(&m.module, &rho);
         let at_zero =
             |starts: &[ProvedStart]| starts.iter().filter(|st| st.pose.alpha == 0.0).count();
         for (undecided, expected) in [
@@ -685,24 +702,11 @@ mod tests {
             (vec![[-0.2, -0.1], [1e-9, 0.1]], false),
             (vec![[-3.0, -1e-9]], false),
         ] {
-            let (mut allowed, mut others) = (ArrayVec::new(), ArrayVec::new());
-            det_zero_starts(
-                &m.module,
-                &rho,
-                &elim,
-                &undecided,
-                &mut allowed,
-                &mut others,
-            );
-            let (to, not) = if expected {
-                (&allowed, &others)
-            } else {
-                (&others, &allowed)
-            };
-            assert_eq!(at_zero(to), 2, "{undecided:?}: {allowed:?} {others:?}");
-            assert_eq!(at_zero(not), 0, "{undecided:?}: {allowed:?} {others:?}");
+            let (to, not) = starts_in(&m, &rho, &undecided, expected);
+            assert_eq!(at_zero(&to), 2, "{undecided:?}: {to:?} {not:?}");
+            assert_eq!(at_zero(&not), 0, "{undecided:?}: {to:?} {not:?}");
             assert!(to.iter().any(|st| (st.pose.p - p).norm() < 1e-6), "{to:?}");
-            for st in allowed.iter().chain(&others) {
+            for st in to.iter().chain(&not) {
                 assert!(residual_mm(&m.module, &st.pose, &rho) <= ACCEPT_RESIDUAL_MM);
                 let (sin, cos) = st.pose.alpha.sin_cos();
                 assert!((st.sc.0 - sin).abs() < 1e-15 && (st.sc.1 - cos).abs() < 1e-15);
@@ -747,22 +751,9 @@ mod tests {
                 (vec![[alpha0 + 2e-12, 0.1]], false),
                 (vec![[-0.1, alpha0 - 2e-12]], false),
             ] {
-                let (mut allowed, mut others) = (ArrayVec::new(), ArrayVec::new());
-                det_zero_starts(
-                    &m.module,
-                    &rho,
-                    &elim,
-                    &undecided,
-                    &mut allowed,
-                    &mut others,
-                );
-                let (to, not) = if expected {
-                    (&allowed, &others)
-                } else {
-                    (&others, &allowed)
-                };
-                let case = format!("{eps}, {undecided:?}: {allowed:?} {others:?}");
-                assert_eq!((at_zero(to), at_zero(not)), (2, 0), "{case}");
+                let (to, not) = starts_in(&m, &rho, &undecided, expected);
+                let case = format!("{eps}, {undecided:?}: {to:?} {not:?}");
+                assert_eq!((at_zero(&to), at_zero(&not)), (2, 0), "{case}");
                 assert!(to.iter().any(|st| (st.pose.p - p).norm() < 1e-6), "{case}");
             }
         }
