@@ -1244,35 +1244,4 @@ pub(crate) fn isolated_working_root(m: &Machine, p: &Vector3<f64>) -> bool {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::wrap_angle;
-    use std::f64::consts::{PI, TAU};
-
-    /// The remainder formula the one-turn shortcut of [`wrap_angle`] replaces.
-    fn by_remainder(a: f64) -> f64 {
-        let w = a.rem_euclid(TAU);
-        if w > PI { w - TAU } else { w }
-    }
-
-    /// Within one turn out, the shortcut gives the remainder's result exactly (a zero result
-    /// always +0); ends and far angles included.
-    #[test]
-    fn wrap_angle_one_turn_out_is_the_remainder() {
-        let mut unit = crate::math::test_rng::lcg(0x9e37_79b9_7f4a_7c15);
-        let mut angles = vec![PI, -PI, 3.0 * PI, -3.0 * PI, TAU, -TAU, 0.0, 1e300, -7.5e3];
-        for k in [PI, 3.0 * PI, TAU] {
-            angles.extend([k.next_up(), k.next_down(), -k.next_up(), -k.next_down()]);
-        }
-        angles.extend((0..200_000).map(|_| (unit() - 0.5) * 7.0 * PI));
-        for a in angles {
-            let w = wrap_angle(a);
-            assert!(w > -PI && w <= PI, "{a} -> {w}");
-            if a.abs() > PI {
-                assert_eq!(w, by_remainder(a), "{a}");
-            }
-            if w == 0.0 {
-                assert!(w.is_sign_positive(), "{a}");
-            }
-        }
-    }
-}
+mod tests;
