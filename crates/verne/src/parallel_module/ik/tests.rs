@@ -450,25 +450,46 @@ fn leg1_postures(m: &Machine, p: &Vector3<f64>) -> (arrayvec::ArrayVec<Leg1, 6>,
     (out, certificate)
 }
 
-/// A point whose cubic (9) has a double root at cos(alpha) = c0 (u^2 and y^2 solve F(c0) =
-/// F'(c0) = 0, which are linear in them; z is free, as neither (9) nor leg I's height depends
-/// on it), and whose leg I reaches there; None where u^2 or y^2 would be negative.
-fn on_double_root(m: &Machine, c0: f64) -> Option<Vector3<f64>> {
+/// Eq. (9) at cos(alpha) = c0 as linear functions of U = u^2 and Y = y^2 (z_p enters neither
+/// it nor leg I's height): F(c0) = f[0] + U f[1] + Y f[2] and F'(c0) = d[0] + U d[1] + Y d[2],
+/// from F(c) = 2 R1^3 r1 c^3 + R1^2 (k0 - U) c^2 - 2 R1 r1 (R1^2 + Y) c + R1^2 U
+/// + (R1^2 + r1^2) Y - R1^2 k0.
+fn eq9_in_u_and_y(m: &Machine, c0: f64) -> ([f64; 3], [f64; 3]) {
     let g = &m.module;
     let (r, rr) = (g.r_big1, g.r_small1);
     let k0 = g.l1 * g.l1 - r * r - rr * rr;
-    // F(c) = 2 R1^3 r1 c^3 + R1^2 (k0 - U) c^2 - 2 R1 r1 (R1^2 + Y) c + R1^2 U
-    //        + (R1^2 + r1^2) Y - R1^2 k0 (eq. (9)): F = f0 + U fu + Y fy, F' = d0 + U du + Y dy.
     let p1 = 2.0 * r * r * r * rr;
-    let f0 = p1 * c0.powi(3) + r * r * k0 * c0 * c0 - 2.0 * r * r * r * rr * c0 - r * r * k0;
-    let (fu, fy) = (r * r * (1.0 - c0 * c0), r * r + rr * rr - 2.0 * r * rr * c0);
-    let d0 = 3.0 * p1 * c0 * c0 + 2.0 * r * r * k0 * c0 - 2.0 * r * r * r * rr;
-    let (du, dy) = (-2.0 * r * r * c0, -2.0 * r * rr);
-    let det = fu * dy - fy * du;
-    let u2 = (fy * d0 - f0 * dy) / det;
-    let y2 = (f0 * du - fu * d0) / det;
-    let reaches = k0 + 2.0 * r * rr * c0 - u2 - y2 > 0.0;
-    (u2 >= 0.0 && y2 >= 0.0 && reaches).then(|| Vector3::new(u2.sqrt() - g.dx1, y2.sqrt(), 1000.0))
+    let f = [
+        p1 * c0.powi(3) + r * r * k0 * c0 * c0 - 2.0 * r * r * r * rr * c0 - r * r * k0,
+        r * r * (1.0 - c0 * c0),
+        r * r + rr * rr - 2.0 * r * rr * c0,
+    ];
+    let d = [
+        3.0 * p1 * c0 * c0 + 2.0 * r * r * k0 * c0 - 2.0 * r * r * r * rr,
+        -2.0 * r * r * c0,
+        -2.0 * r * rr,
+    ];
+    (f, d)
+}
+
+/// The point with u = sqrt(U), y = sqrt(Y) and z = 1000 mm when leg I reaches at cos(alpha) =
+/// c0 there; None where U or Y is negative or leg I cannot reach.
+fn point_from_u_and_y(m: &Machine, c0: f64, u2: f64, y2: f64) -> Option<Vector3<f64>> {
+    let g = &m.module;
+    let k1 = g.l1 * g.l1 - g.r_big1 * g.r_big1 - g.r_small1 * g.r_small1
+        + 2.0 * g.r_big1 * g.r_small1 * c0;
+    (u2 >= 0.0 && y2 >= 0.0 && k1 - u2 - y2 > 0.0)
+        .then(|| Vector3::new(u2.sqrt() - g.dx1, y2.sqrt(), 1000.0))
+}
+
+/// A point whose cubic (9) has a double root at cos(alpha) = c0 (F(c0) = F'(c0) = 0, linear
+/// in u^2 and y^2) and whose leg I reaches there.
+fn on_double_root(m: &Machine, c0: f64) -> Option<Vector3<f64>> {
+    let (f, d) = eq9_in_u_and_y(m, c0);
+    let det = f[1] * d[2] - f[2] * d[1];
+    let u2 = (f[2] * d[0] - f[0] * d[2]) / det;
+    let y2 = (f[0] * d[1] - f[1] * d[0]) / det;
+    point_from_u_and_y(m, c0, u2, y2)
 }
 
 /// How many roots the cubic (9) of `p` has near its critical point close to `c0` (two or none),
