@@ -1003,6 +1003,55 @@ const fn half_angle_table(imag: bool) -> [[f64; 9]; 5] {
 mod tests {
     use super::*;
 
+    /// sin d and cos d by the series of [`sin_cos_small`] are within an ulp of the library's
+    /// (and of sin^2 + cos^2 = 1) over |d| < [`SMALL_ANGLE`]: 200,001 angles with the ends, where
+    /// the series' last terms matter most.
+    #[test]
+    fn sin_cos_small_is_the_library_to_an_ulp() {
+        let mut angles: Vec<f64> = (0..=200_000)
+            .map(|k| (k as f64 / 100_000.0 - 1.0) * SMALL_ANGLE)
+            .collect();
+        angles.extend([
+            SMALL_ANGLE.next_down(),
+            -SMALL_ANGLE.next_down(),
+            1e-300,
+            -1e-8,
+            0.0,
+        ]);
+        for d in angles {
+            let (s, c) = sin_cos_small(d);
+            let (ls, lc) = d.sin_cos();
+            let ulp = |x: f64| (x.abs().next_up() - x.abs()).max(f64::MIN_POSITIVE);
+            assert!(
+                (s - ls).abs() <= ulp(ls) && (c - lc).abs() <= ulp(lc),
+                "{d}: ({s}, {c}) vs ({ls}, {lc})"
+            );
+            assert!((s * s + c * c - 1.0).abs() <= 4.0 * f64::EPSILON, "{d}");
+        }
+    }
+
+    /// The sin and cos after a Newton step ([`sin_cos_after_step`]) are those of the new angle
+    /// to rounding: steps below 1e-3 (two terms of the series), up to [`SMALL_ANGLE`] (six) and
+    /// beyond (the library), from angles all round the circle.
+    #[test]
+    fn sin_cos_after_a_step_are_those_of_the_new_angle() {
+        let mut unit = crate::math::test_rng::lcg(0x51_c0_57e9);
+        for _ in 0..100_000 {
+            let a = (2.0 * unit() - 1.0) * std::f64::consts::PI;
+            let scale =
+                [1e-9, 1e-5, 9.9e-4, 1.01e-3, 0.1, 0.2499, 0.26, 2.0][(unit() * 8.0) as usize];
+            let d = (2.0 * unit() - 1.0) * scale;
+            let (sin_a, cos_a) = a.sin_cos();
+            let alpha = a - d;
+            let (s, c) = sin_cos_after_step(sin_a, cos_a, alpha, d);
+            let (ls, lc) = alpha.sin_cos();
+            assert!(
+                (s - ls).abs() <= 5e-16 && (c - lc).abs() <= 5e-16,
+                "{a} - {d}: ({s}, {c}) vs ({ls}, {lc})"
+            );
+        }
+    }
+
     fn sample() -> Trig {
         Trig {
             cos: [0.3, -1.2, 0.7, 0.25, -0.4],
