@@ -1035,7 +1035,7 @@ mod tests {
     /// beyond (the library), from angles all round the circle.
     #[test]
     fn sin_cos_after_a_step_are_those_of_the_new_angle() {
-        let mut unit = crate::math::test_rng::lcg(0x51_c0_57e9);
+        let mut unit = crate::math::test_rng::lcg(0x51c0_57e9);
         for _ in 0..100_000 {
             let a = (2.0 * unit() - 1.0) * std::f64::consts::PI;
             let scale =

@@ -1,4 +1,13 @@
-use super::wrap_angle;
+//! Tests of the parallel module's IK by its parts: each part for what it promises (the fast
+//! path's second half alone, the bounds on eq. (9)'s rounding, the order and stopping rule of
+//! the steps on leg I, the lanes' start and certificate, the postures at a double root of (9)).
+
+use super::{IkBranch, Leg1, Leg1Equations, solve, working, working_by_cubic, wrap_angle};
+use crate::certificate::Certificate;
+use crate::selftest::hard_sets::random_geometries;
+use crate::spec::Machine;
+use crate::tolerance::NEWTON_STEP_STOP;
+use nalgebra::Vector3;
 use std::f64::consts::{PI, TAU};
 
 /// The remainder formula the one-turn shortcut of [`wrap_angle`] replaces.
@@ -30,12 +39,6 @@ fn wrap_angle_one_turn_out_is_the_remainder() {
 }
 
 // ------------------------------------------------- the solvers against each other on a grid
-
-use super::{IkBranch, solve, working, working_by_cubic};
-use crate::certificate::Certificate;
-use crate::selftest::hard_sets::random_geometries;
-use crate::spec::Machine;
-use nalgebra::Vector3;
 
 /// The default machine and four random valid geometries (each dimension within 30 % of the
 /// default's, with the variants of [`random_geometries`]).
@@ -163,19 +166,19 @@ fn eq9_error_bounds_are_the_magnitudes_and_hold() {
 
 // ------------------------------------------------------------- Newton's and Chebyshev's steps
 
-use super::{Leg1, Leg1Equations};
-use crate::tolerance::NEWTON_STEP_STOP;
+/// A point and one of its leg-I postures.
+type PointPosture = (Vector3<f64>, Leg1);
 
 /// Every leg-I posture (alpha, rho1) of the points of an n-grid on the machines, from the
 /// complete solver (polished to rounding), with its point; postures whose Jacobian in (alpha,
 /// rho1) is ill-conditioned (|det| below 1e-3 of its scale: near a fold, where no step
 /// converges fast) are left out.
-fn leg1_roots(n: usize) -> Vec<(Machine, Vec<(Vector3<f64>, Leg1)>)> {
+fn leg1_roots(n: usize) -> Vec<(Machine, Vec<PointPosture>)> {
     machines()
         .into_iter()
         .map(|m| {
             let g = &m.module;
-            let mut out: Vec<(Vector3<f64>, Leg1)> = Vec::new();
+            let mut out: Vec<PointPosture> = Vec::new();
             for p in grid(n) {
                 let branches = solve(&m, &p);
                 for b in branches.iter().step_by(4) {
@@ -187,8 +190,9 @@ fn leg1_roots(n: usize) -> Vec<(Machine, Vec<(Vector3<f64>, Leg1)>)> {
                         cos,
                     };
                     let (r, rr, dz) = (g.r_big1, g.r_small1, p.z - l.rho1);
+                    // det of the Jacobian (2 R1 r1 s, -2 dz; -y R1 s + R1 c dz, -R1 s).
                     let det =
-                        -2.0 * r * r * rr * sin * sin - 2.0 * dz * (-p.y * r * sin + r * cos * dz);
+                        -2.0 * r * r * rr * sin * sin + 2.0 * dz * (-p.y * r * sin + r * cos * dz);
                     let scale = r * r * rr + dz * dz * r + p.y.abs() * r * dz.abs();
                     if det.abs() > 1e-3 * scale {
                         out.push((p, l));
