@@ -273,6 +273,39 @@ fn chebyshev_step_on_leg1_is_of_order_three() {
     }
 }
 
+/// Chebyshev's step as [`steps_to_settle`] takes it (the posture must stay usable).
+fn chebyshev_step(eqs: &Leg1Equations, l: &Leg1) -> Option<(Leg1, bool)> {
+    let step = eqs.corrected_step(l);
+    step.usable.then_some((step.leg1, step.settled))
+}
+
+/// Newton's step as [`steps_to_settle`] takes it.
+fn newton_step(eqs: &Leg1Equations, l: &Leg1) -> Option<(Leg1, bool)> {
+    let (f, dz) = eqs.residuals(l);
+    eqs.newton_step(l, f, dz)
+}
+
+/// How many of `step` it takes from `start` until one says settled (at most eight); every
+/// posture said settled is checked within the stopping rule of `root`.
+fn steps_to_settle(
+    eqs: &Leg1Equations,
+    start: Leg1,
+    root: &Leg1,
+    step: fn(&Leg1Equations, &Leg1) -> Option<(Leg1, bool)>,
+    at: &dyn Fn() -> String,
+) -> usize {
+    let mut cur = start;
+    for n in 1..=8 {
+        let (next, settled) = step(eqs, &cur).unwrap_or_else(|| panic!("step {n}: {}", at()));
+        cur = next;
+        if settled {
+            assert!(within_stop(&cur, root), "step {n}: {cur:?}: {}", at());
+            return n;
+        }
+    }
+    panic!("not settled in 8 steps: {}", at());
+}
+
 /// Both steps say `settled` only within the stopping rule of the root, from starts 1e-2 to
 /// 1e-14 off it, and they settle as soon as their order allows (the counts measured on these
 /// postures; one more is a polish that missed its prediction of the next step): Chebyshev's
@@ -297,39 +330,49 @@ fn leg1_steps_settle_only_at_the_root_and_soon() {
         for (p, root) in &roots {
             let eqs = Leg1Equations::new(&m.module, p);
             for (d, chebyshev, newton) in cases {
-                let at = |n: usize| format!("{}: {p:?} {root:?}, {d:e} off, step {n}", m.name);
-                let mut cur = moved(root, d, -70.0 * d);
-                let mut settled_after = None;
-                for n in 1..=8 {
-                    let step = eqs.corrected_step(&cur);
-                    assert!(step.usable, "{}", at(n));
-                    cur = step.leg1;
-                    if step.settled {
-                        assert!(within_stop(&cur, root), "{}: {cur:?}", at(n));
-                        settled_after = Some(n);
-                        break;
-                    }
-                }
-                assert!(settled_after.is_some_and(|n| n <= chebyshev), "{}", at(0));
-                let mut cur = moved(root, d, -70.0 * d);
-                let mut settled_after = None;
-                for n in 1..=8 {
-                    let (f, dz) = eqs.residuals(&cur);
-                    let (next, settled) = eqs.newton_step(&cur, f, dz).expect("a step");
-                    cur = next;
-                    if settled {
-                        assert!(within_stop(&cur, root), "Newton {}: {cur:?}", at(n));
-                        settled_after = Some(n);
-                        break;
-                    }
-                }
-                assert!(
-                    settled_after.is_some_and(|n| n <= newton),
-                    "Newton {}",
-                    at(0)
-                );
+                let at = || format!("{}: {p:?} {root:?}, {d:e} off", m.name);
+                let start = moved(root, d, -70.0 * d);
+                let n = steps_to_settle(&eqs, start, root, chebyshev_step, &at);
+                assert!(n <= chebyshev, "{} steps: {}", n, at());
+                let n = steps_to_settle(&eqs, start, root, newton_step, &at);
+                assert!(n <= newton, "Newton, {} steps: {}", n, at());
             }
         }
+    }
+}
+
+/// On y = 0 from Table II's starts with rho1 alone off by 1e-9 to 10 mm (alpha = 0: eq. (14)
+/// holds for every rho1, and neither step moves alpha, so a step that settled on alpha's step
+/// alone would stop short), both steps say `settled` only within the stopping rule of the
+/// posture, in at most three steps from 1e-3 mm (and eight from 10 mm).
+#[test]
+fn leg1_steps_from_table_ii_starts_settle_only_at_the_root() {
+    for m in machines() {
+        let mut postures = 0;
+        for p in grid(10).map(|p| Vector3::new(p.x, 0.0, p.z)) {
+            let eqs = Leg1Equations::new(&m.module, &p);
+            for b in solve(&m, &p).iter().step_by(4).filter(|b| b.alpha == 0.0) {
+                let root = moved(
+                    &Leg1 {
+                        alpha: 0.0,
+                        rho1: b.rho.x,
+                        sin: 0.0,
+                        cos: 1.0,
+                    },
+                    0.0,
+                    0.0,
+                );
+                for d in [10.0, -1.0, 1e-3, -1e-6, 1e-9] {
+                    let at = || format!("{}: {p:?} {root:?}, rho1 {d:e} off", m.name);
+                    let start = moved(&root, 0.0, d);
+                    let limit = if d.abs() <= 1e-3 { 3 } else { 8 };
+                    assert!(steps_to_settle(&eqs, start, &root, chebyshev_step, &at) <= limit);
+                    assert!(steps_to_settle(&eqs, start, &root, newton_step, &at) <= limit);
+                }
+                postures += 1;
+            }
+        }
+        assert!(postures > 100, "{}: {postures}", m.name);
     }
 }
 
