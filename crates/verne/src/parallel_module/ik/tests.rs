@@ -204,6 +204,25 @@ fn leg1_roots(n: usize) -> Vec<(Machine, Vec<PointPosture>)> {
         .collect()
 }
 
+/// The postures at alpha = 0 of points on y = 0 (Table II: eq. (14) holds there for every
+/// rho1), from the complete solver, with their points: at least a hundred on each machine.
+fn table_ii_postures(m: &Machine) -> Vec<PointPosture> {
+    let mut postures: Vec<PointPosture> = Vec::new();
+    for p in grid(10).map(|p| Vector3::new(p.x, 0.0, p.z)) {
+        for b in solve(m, &p).iter().step_by(4).filter(|b| b.alpha == 0.0) {
+            let l = Leg1 {
+                alpha: 0.0,
+                rho1: b.rho.x,
+                sin: 0.0,
+                cos: 1.0,
+            };
+            postures.push((p, l));
+        }
+    }
+    assert!(postures.len() > 100, "{}: {}", m.name, postures.len());
+    postures
+}
+
 /// `l` moved by (da, dr) with its sin and cos.
 fn moved(l: &Leg1, da: f64, dr: f64) -> Leg1 {
     let alpha = l.alpha + da;
@@ -243,36 +262,6 @@ fn worst_after_one_step(d: f64, step: impl Fn(&Leg1Equations, &Leg1) -> Option<L
     worst
 }
 
-/// Newton's step on eqs. (10) and (14) is of order two: from 1e-3 rad and 0.07 mm off a root
-/// (about 27,000 postures on five machines), 5e-7 rad off or less after it (measured: 1.1e-6
-/// worst at 1e-3, 1.1e-8 at 1e-4), at most 5 d^2; a step with a wrong Jacobian would be of
-/// order one (about d).
-#[test]
-fn newton_step_on_leg1_is_of_order_two() {
-    let newton = |eqs: &Leg1Equations, l: &Leg1| {
-        let (f, dz) = eqs.residuals(l);
-        eqs.newton_step(l, f, dz).map(|(next, _)| next)
-    };
-    for d in [1e-3, 1e-4] {
-        let worst = worst_after_one_step(d, newton);
-        assert!(worst <= 5.0 * d * d, "{d:e}: {worst:e}");
-    }
-}
-
-/// Chebyshev's corrected step is of order three (measured: 2.5e-6 worst at 1e-2, 2.4e-9 at
-/// 1e-3): at most 5 d^3 off, where Newton's step (order two, above) is about d^2 / 2.
-#[test]
-fn chebyshev_step_on_leg1_is_of_order_three() {
-    let chebyshev = |eqs: &Leg1Equations, l: &Leg1| {
-        let step = eqs.corrected_step(l);
-        step.usable.then_some(step.leg1)
-    };
-    for d in [1e-2, 1e-3] {
-        let worst = worst_after_one_step(d, chebyshev);
-        assert!(worst <= 5.0 * d * d * d, "{d:e}: {worst:e}");
-    }
-}
-
 /// Chebyshev's step as [`steps_to_settle`] takes it (the posture must stay usable).
 fn chebyshev_step(eqs: &Leg1Equations, l: &Leg1) -> Option<(Leg1, bool)> {
     let step = eqs.corrected_step(l);
@@ -283,6 +272,27 @@ fn chebyshev_step(eqs: &Leg1Equations, l: &Leg1) -> Option<(Leg1, bool)> {
 fn newton_step(eqs: &Leg1Equations, l: &Leg1) -> Option<(Leg1, bool)> {
     let (f, dz) = eqs.residuals(l);
     eqs.newton_step(l, f, dz)
+}
+
+/// Newton's step on eqs. (10) and (14) is of order two: from d = 1e-3 and 1e-4 rad (and 70 d
+/// mm) off a root (about 27,000 postures on five machines), at most 5 d^2 off after it
+/// (measured: 1.1 d^2 worst); a step with a wrong Jacobian would be of order one (about d).
+#[test]
+fn newton_step_on_leg1_is_of_order_two() {
+    for d in [1e-3, 1e-4] {
+        let worst = worst_after_one_step(d, |e, l| newton_step(e, l).map(|(next, _)| next));
+        assert!(worst <= 5.0 * d * d, "{d:e}: {worst:e}");
+    }
+}
+
+/// Chebyshev's corrected step is of order three (measured: 2.5e-6 worst at 1e-2, 2.4e-9 at
+/// 1e-3): at most 5 d^3 off, where Newton's step (order two, above) is about d^2 / 2.
+#[test]
+fn chebyshev_step_on_leg1_is_of_order_three() {
+    for d in [1e-2, 1e-3] {
+        let worst = worst_after_one_step(d, |e, l| chebyshev_step(e, l).map(|(next, _)| next));
+        assert!(worst <= 5.0 * d * d * d, "{d:e}: {worst:e}");
+    }
 }
 
 /// How many of `step` it takes from `start` until one says settled (at most eight); every
@@ -348,31 +358,16 @@ fn leg1_steps_settle_only_at_the_root_and_soon() {
 #[test]
 fn leg1_steps_from_table_ii_starts_settle_only_at_the_root() {
     for m in machines() {
-        let mut postures = 0;
-        for p in grid(10).map(|p| Vector3::new(p.x, 0.0, p.z)) {
-            let eqs = Leg1Equations::new(&m.module, &p);
-            for b in solve(&m, &p).iter().step_by(4).filter(|b| b.alpha == 0.0) {
-                let root = moved(
-                    &Leg1 {
-                        alpha: 0.0,
-                        rho1: b.rho.x,
-                        sin: 0.0,
-                        cos: 1.0,
-                    },
-                    0.0,
-                    0.0,
-                );
-                for d in [10.0, -1.0, 1e-3, -1e-6, 1e-9] {
-                    let at = || format!("{}: {p:?} {root:?}, rho1 {d:e} off", m.name);
-                    let start = moved(&root, 0.0, d);
-                    let limit = if d.abs() <= 1e-3 { 3 } else { 8 };
-                    assert!(steps_to_settle(&eqs, start, &root, chebyshev_step, &at) <= limit);
-                    assert!(steps_to_settle(&eqs, start, &root, newton_step, &at) <= limit);
-                }
-                postures += 1;
+        for (p, root) in &table_ii_postures(&m) {
+            let eqs = Leg1Equations::new(&m.module, p);
+            for d in [10.0, -1.0, 1e-3, -1e-6, 1e-9] {
+                let at = || format!("{}: {p:?} {root:?}, rho1 {d:e} off", m.name);
+                let start = moved(root, 0.0, d);
+                let limit = if d.abs() <= 1e-3 { 3 } else { 8 };
+                assert!(steps_to_settle(&eqs, start, root, chebyshev_step, &at) <= limit);
+                assert!(steps_to_settle(&eqs, start, root, newton_step, &at) <= limit);
             }
         }
-        assert!(postures > 100, "{}: {postures}", m.name);
     }
 }
 
@@ -756,25 +751,10 @@ fn polish_converges_from_near_starts() {
                 check(&m, p, root, moved(root, d, -70.0 * d));
             }
         }
-        let mut table_ii = 0;
-        for p in grid(10).map(|p| Vector3::new(p.x, 0.0, p.z)) {
-            for b in solve(&m, &p).iter().step_by(4).filter(|b| b.alpha == 0.0) {
-                let root = moved(
-                    &Leg1 {
-                        alpha: 0.0,
-                        rho1: b.rho.x,
-                        sin: 0.0,
-                        cos: 1.0,
-                    },
-                    0.0,
-                    0.0,
-                );
-                for d in [1e-3, -1e-5, 1e-8] {
-                    check(&m, &p, &root, moved(&root, 0.0, d));
-                }
-                table_ii += 1;
+        for (p, root) in &table_ii_postures(&m) {
+            for d in [1e-3, -1e-5, 1e-8] {
+                check(&m, p, root, moved(root, 0.0, d));
             }
         }
-        assert!(table_ii > 100, "{}: {table_ii}", m.name);
     }
 }
