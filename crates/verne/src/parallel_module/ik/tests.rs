@@ -631,7 +631,7 @@ fn a_posture_met_twice_is_listed_once() {
             unequal_bits += usize::from(alone[0].rho1 != again[0].rho1);
         }
     }
-    // The duplicate test is not one of equality: most pairs differ in their last bits.
+    // The duplicate test is not one of equality: over a hundred pairs differ in their last bits.
     assert!(unequal_bits > 100, "{unequal_bits}");
 }
 
@@ -656,9 +656,9 @@ fn an_exact_double_root_at_alpha_zero_with_leg_one_stretched() {
 }
 
 /// The complete solver's postures are mostly recognised as at the rounding level of leg I's
-/// equations ([`Leg1Equations::at_rounding`]; 95.7 % of 17,184 measured, the rest a few ulps
-/// above it), and polishing one of those again returns it bit for bit (no Newton step is taken
-/// from a posture no step can improve); the others move within the stopping rule.
+/// equations ([`Leg1Equations::at_rounding`]; 95.7 % of 17,184 measured), and polishing one
+/// of those again returns it bit for bit (no Newton step is taken from a posture no step can
+/// improve); the others move within the stopping rule.
 #[test]
 fn polished_postures_are_at_rounding() {
     use super::polish_leg1;
