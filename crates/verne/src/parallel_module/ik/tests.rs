@@ -534,6 +534,15 @@ fn on_double_root(m: &Machine, c0: f64) -> Option<Vector3<f64>> {
     point_from_u_and_y(m, c0, u2, y2)
 }
 
+/// The points of [`on_double_root`] for c0 = -0.9, -0.8, ..., 0.9 where there is one, with
+/// their c0.
+fn double_root_points(m: &Machine) -> Vec<(f64, Vector3<f64>)> {
+    (0..19)
+        .map(|i| -0.9 + 0.1 * f64::from(i))
+        .filter_map(|c0| on_double_root(m, c0).map(|p| (c0, p)))
+        .collect()
+}
+
 /// How many roots the cubic (9) of `p` has near its critical point close to `c0` (two or none),
 /// from the sign of the cubic there and of its second derivative, the cubic evaluated in
 /// double-double with its error bound (the test's own Horner on [`super::eq9_tracked`]); None
@@ -571,11 +580,7 @@ fn postures_at_a_double_root_of_eq9() {
     use super::leg1_residual_mm;
     let (mut decided, mut extended) = (0, 0);
     for m in machines() {
-        for i in 0..19 {
-            let c0 = -0.9 + 0.1 * f64::from(i);
-            let Some(p0) = on_double_root(&m, c0) else {
-                continue;
-            };
+        for (c0, p0) in double_root_points(&m) {
             let u0 = p0.x + m.module.dx1;
             for rel in [1e-6, 1e-9, 1e-12, 1e-14, 0.0, -1e-14, -1e-12, -1e-9, -1e-6] {
                 let p = Vector3::new(u0 * (1.0 + rel) - m.module.dx1, p0.y, p0.z);
@@ -690,11 +695,7 @@ fn polish_returns_the_best_posture_it_met() {
     use super::{leg1_residual_mm, polish_leg1};
     let mut folds = 0;
     for m in machines() {
-        for i in 0..19 {
-            let c0 = -0.9 + 0.1 * f64::from(i);
-            let Some(p) = on_double_root(&m, c0) else {
-                continue;
-            };
+        for (c0, p) in double_root_points(&m) {
             let (legs, _) = leg1_postures(&m, &p);
             for l in legs.iter().filter(|l| (l.cos - c0).abs() < 1e-2) {
                 for d in [1e-2, 1e-3, -1e-3] {
