@@ -374,11 +374,11 @@ fn polish_leg1(g: &ModuleGeometry, p: &Vector3<f64>, start: Leg1) -> Leg1 {
         if amax(f) == 0.0 {
             break;
         }
-        let Some((next, settled)) = eqs.newton_step(&cur, f, dz) else {
+        let Some(step) = eqs.newton_step(&cur, f, dz) else {
             break;
         };
-        cur = next;
-        if settled {
+        cur = step.leg1;
+        if step.settled {
             return with_wrapped_alpha(cur);
         }
         (f, dz) = eqs.residuals(&cur);
@@ -389,7 +389,7 @@ fn polish_leg1(g: &ModuleGeometry, p: &Vector3<f64>, start: Leg1) -> Leg1 {
     with_wrapped_alpha(best.0)
 }
 
-/// One step of [`Leg1Equations::corrected_step`].
+/// One step of [`Leg1Equations::corrected_step`] or [`Leg1Equations::newton_step`].
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Leg1Step {
     pub leg1: Leg1,
@@ -398,6 +398,11 @@ pub(crate) struct Leg1Step {
     /// False when the Jacobian was singular, the step not finite, or longer than the series
     /// of sin and cos allow ([`SMALL_ANGLE`]): `leg1` is then meaningless.
     pub usable: bool,
+    /// The step's prediction of the error left in (alpha, rho1) (rad, mm): the leading term of
+    /// its error, bounded term by term; `settled` compares it with the stopping rule (read
+    /// otherwise only by the tests of the prediction).
+    #[cfg_attr(not(test), allow(dead_code))]
+    pub left: [f64; 2],
 }
 
 /// Eqs. (10) and (14) of leg I for one point, as g1 = u^2 + y^2 + (z - rho1)^2 - K1(alpha) and
@@ -457,7 +462,7 @@ impl Leg1Equations {
     /// The Newton step from `cur` (residuals f, dz = z - rho1), and whether it settles the
     /// posture; None on a singular Jacobian.
     #[inline(always)]
-    fn newton_step(&self, cur: &Leg1, f: [f64; 2], dz: f64) -> Option<(Leg1, bool)> {
+    fn newton_step(&self, cur: &Leg1, f: [f64; 2], dz: f64) -> Option<Leg1Step> {
         let (r, rr, y) = (self.r, self.rr, self.y);
         // Jacobian of (g1, g2) in (alpha, rho1), solved by Cramer's rule.
         let (s, c) = (cur.sin, cur.cos);
@@ -482,7 +487,12 @@ impl Leg1Equations {
         // A step this small came from residuals at rounding level (Newton converges
         // quadratically).
         if step[0].abs() < NEWTON_STEP_STOP && step[1].abs() < rho_stop {
-            return Some((next, true));
+            return Some(Leg1Step {
+                leg1: next,
+                settled: true,
+                usable: true,
+                left: [0.0; 2],
+            });
         }
         // Otherwise Newton's error after this step is J^-1 times what the linear model missed,
         // (1/2) H[step, step] (H: second derivatives of g1, g2, which are quadratic in rho1 and
@@ -494,7 +504,12 @@ impl Leg1Equations {
         let next_rho1 = j21.abs() * miss1 + j11.abs() * miss2;
         let settled = next_alpha <= PREDICTED_STEP_FRACTION * NEWTON_STEP_STOP * det.abs()
             && next_rho1 <= PREDICTED_STEP_FRACTION * rho_stop * det.abs();
-        Some((next, settled))
+        Some(Leg1Step {
+            leg1: next,
+            settled,
+            usable: true,
+            left: [next_alpha / det.abs(), next_rho1 / det.abs()],
+        })
     }
 }
 
@@ -557,6 +572,7 @@ impl Leg1Equations {
             leg1,
             settled: small_step | small_left,
             usable,
+            left: [left_alpha, left_rho1],
         }
     }
 }
