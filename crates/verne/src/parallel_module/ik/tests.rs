@@ -134,6 +134,98 @@ fn a_point_gets_the_same_bits_alone_and_side_by_side() {
     }
 }
 
+/// A point whose leg II is stretched to within h = 1e-3 to 1e-5 mm, or fully (h = 0), or short
+/// by rounding noise (the square root's argument -1e-8 mm^2, within [`crate::tolerance::SQRT_ARG_REL`] L2^2 of
+/// zero): built from a leg-I posture (alpha, rho1) by eqs. (14) and (10), with y set by
+/// bisection so that leg II's argument in eq. (12) is that. The complete solver finds the
+/// branches on that posture with both roots of (12), z - R2 sin(alpha) -+ h (h = 0 for the
+/// last two), on five machines (115 points built, where leg III reaches too): a reachable leg
+/// is never called out of reach, however little room it has.
+#[test]
+fn a_stretched_outer_leg_still_reaches() {
+    let mut built = 0;
+    for m in machines() {
+        let g = &m.module;
+        let (r, rr) = (g.r_big1, g.r_small1);
+        let k0 = g.l1 * g.l1 - r * r - rr * rr;
+        for (alpha, u_sign) in [0.1, 0.25, 0.4, 0.55, -0.3, -0.5]
+            .into_iter()
+            .flat_map(|a| [(a, 1.0), (a, -1.0)])
+        {
+            let (s, c) = f64::sin_cos(alpha);
+            let z = 1000.0;
+            // eq. (14) gives z - rho1 from y, eq. (10) u; then leg II's argument of (12).
+            let point = |y: f64| {
+                let dz = -y * (r * c - rr) / (r * s);
+                let u2 = k0 + 2.0 * r * rr * c - y * y - dz * dz;
+                let x = u_sign * u2.max(0.0).sqrt() - g.dx1;
+                let arg = g.l2 * g.l2 - (x + g.dx2).powi(2) - (y - g.r_big2 * c + g.r4).powi(2);
+                (Vector3::new(x, y, z), z - dz, u2, arg)
+            };
+            for room in [1e-6f64, 1e-8, 1e-10, 0.0, -1e-8] {
+                let h = room.max(0.0).sqrt();
+                // The first change of sign of arg - room along y, where leg I reaches.
+                let excess = |y: f64| {
+                    let (_, _, u2, arg) = point(y);
+                    (u2 > 1.0).then_some(arg - room)
+                };
+                let bracket =
+                    (-1500..1500)
+                        .map(f64::from)
+                        .find_map(|y| match (excess(y), excess(y + 1.0)) {
+                            (Some(a), Some(b)) if (a < 0.0) != (b < 0.0) => {
+                                Some((y, y + 1.0, a < 0.0))
+                            }
+                            _ => None,
+                        });
+                let Some((mut lo, mut hi, lo_negative)) = bracket else {
+                    continue;
+                };
+                for _ in 0..100 {
+                    let mid = 0.5 * (lo + hi);
+                    if (excess(mid).unwrap() < 0.0) == lo_negative {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                let (p, rho1, _, _) = point(lo);
+                let dy3 = p.y + g.r_big2 * c - g.r4;
+                if g.l3 * g.l3 - (p.x + g.dx2).powi(2) - dy3 * dy3 < 1.0 {
+                    continue; // leg III cannot reach: no branch on this posture
+                }
+                built += 1;
+                // Both roots of (12) on the posture, each with (rho2 - off2)^2 = h^2 to the
+                // rounding of the square root's argument (terms of L2^2, here and in the test's
+                // construction: 64 eps L2^2, about 1.3e-8 mm^2).
+                let off2 = z - g.r_big2 * s;
+                let full = solve(&m, &p);
+                let rho2: Vec<f64> = full
+                    .iter()
+                    .filter(|b| (b.alpha - alpha).abs() < 1e-9 && (b.rho.x - rho1).abs() < 1e-6)
+                    .map(|b| b.rho.y)
+                    .collect();
+                let root = |below: bool| {
+                    rho2.iter().any(|&r2| {
+                        ((r2 - off2).powi(2) - h * h).abs() <= 64.0 * f64::EPSILON * g.l2 * g.l2
+                            && (if below {
+                                r2 <= off2 + 1e-9
+                            } else {
+                                r2 >= off2 - 1e-9
+                            })
+                    })
+                };
+                assert!(
+                    root(true) && root(false),
+                    "{}: {p:?}, h {h:e}: {off2} -+ h not in {full:?}",
+                    m.name
+                );
+            }
+        }
+    }
+    assert!(built >= 100, "{built}");
+}
+
 /// Points off the degenerate sets (the grid above) have their roots of eq. (9) proved simple in
 /// double precision: the certificate is `Double`, no root goes to the factors of leg I (which
 /// a bound on the coefficients' error made too large would send them to).
