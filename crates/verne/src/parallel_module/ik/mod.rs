@@ -400,7 +400,8 @@ pub(crate) struct Leg1Step {
     pub usable: bool,
     /// The step's prediction of the error left in (alpha, rho1) (rad, mm): the leading term of
     /// its error, bounded term by term; `settled` compares it with the stopping rule (read
-    /// otherwise only by the tests of the prediction).
+    /// otherwise only by the tests of the prediction). Zero when Newton's step settled on its
+    /// own size (no prediction made).
     #[cfg_attr(not(test), allow(dead_code))]
     pub left: [f64; 2],
 }
