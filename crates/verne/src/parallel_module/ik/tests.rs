@@ -137,10 +137,10 @@ fn a_point_gets_the_same_bits_alone_and_side_by_side() {
 /// A point whose leg II is stretched to within h = 1e-3 to 1e-5 mm, or fully (h = 0), or short
 /// by rounding noise (the square root's argument -1e-8 mm^2, within
 /// [`crate::tolerance::SQRT_ARG_REL`] L2^2 of zero): built from a leg-I posture (alpha, rho1)
-/// by eqs. (14) and (10), with y set by bisection so that leg II's argument in eq. (12) is that. The complete solver finds the
-/// branches on that posture with both roots of (12), z - R2 sin(alpha) -+ h (h = 0 for the
-/// last two), on five machines (115 points built, where leg III reaches too): a reachable leg
-/// is never called out of reach, however little room it has.
+/// by eqs. (14) and (10), with y set by bisection so that leg II's argument in eq. (12) is that.
+/// The complete solver finds the branches on that posture with both roots of (12), z - R2
+/// sin(alpha) -+ h (h = 0 for the last two), on five machines (115 points built, where leg III
+/// reaches too): a reachable leg is never called out of reach, however little room it has.
 #[test]
 fn a_stretched_outer_leg_still_reaches() {
     let mut built = 0;
