@@ -284,7 +284,8 @@ fn yp_zero_exact_and_nudged() {
                 at_pi += (ang(*a, PI) <= TRIP_RAD) as usize;
             }
             // Each leg-I posture carries 2 x 2 branches (eqs. (12)-(13)); postures whose legs II
-            // or III cannot reach the point carry none.
+            // or III cannot reach the point carry none (and a leg stretched to h = 0, its two
+            // roots listed once, is at none of these points).
             if exact.len() % 4 != 0 {
                 failures.push(format!("p={p:?}: {} branches", exact.len()));
             }

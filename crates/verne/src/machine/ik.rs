@@ -31,7 +31,7 @@ use crate::parallel_module::branches::{
     Config, Reason, Verdict, cos_tilt_max, leg_state, listed_in_order,
 };
 use crate::parallel_module::equations::{ModulePose, Sliders, residual_mm_sc};
-use crate::parallel_module::ik::{Leg1, posture_branches, wrap_angle};
+use crate::parallel_module::ik::{Leg1, distinct_branches, posture_branches, wrap_angle};
 use crate::parallel_module::leg1_certify;
 use crate::spec::{Machine, TableGeometry};
 use crate::tolerance::{
@@ -426,7 +426,8 @@ pub fn machine_ik_into(
             p,
             alpha: leg1.alpha,
         };
-        for b in four {
+        let (four, n) = distinct_branches(four);
+        for b in &four[..n] {
             if residual_mm_sc(g, &module, &b.rho, sin, cos) > ACCEPT_RESIDUAL_MM {
                 continue;
             }

@@ -29,6 +29,25 @@ impl IkBranch {
 /// no others.
 pub type IkBranches = Certified<IkBranch, MAX_IK_BRANCHES>;
 
+/// The distinct branches among one posture's four (in `four_branches`' order: (s2, s3) = lower
+/// or upper root of eqs. (12)-(13), lower first), as the first `n` of the returned four: all four,
+/// but where the two roots of (12) or (13) meet (a stretched outer leg, its rod horizontal:
+/// h = sqrt(L^2 - dx^2 - dy^2) within [`crate::tolerance::CONFIG_SIGN_MM`] of zero, both roots
+/// labelled -1) the branch is listed once, with the lower root (the two differ by 2 h). The
+/// lower root is always labelled -1, so two of a posture's branches share a configuration
+/// exactly when a leg's roots meet.
+#[inline(always)]
+pub(crate) fn distinct_branches(four: [IkBranch; 4]) -> ([IkBranch; 4], usize) {
+    let leg3_meets = four[0].config == four[1].config;
+    let leg2_meets = four[0].config == four[2].config;
+    match (leg2_meets, leg3_meets) {
+        (false, false) => (four, 4),
+        (false, true) => ([four[0], four[2], four[1], four[3]], 2),
+        (true, false) => (four, 2),
+        (true, true) => (four, 1),
+    }
+}
+
 /// A leg-I posture: an orientation alpha and the slider-1 position that goes with it.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Leg1 {

@@ -2,8 +2,14 @@
 //! path's second half alone, the bounds on eq. (9)'s rounding, the order and stopping rule of
 //! the steps on leg I, the lanes' start and certificate, the postures at a double root of (9)).
 
-use super::{IkBranch, Leg1, Leg1Equations, solve, working, working_by_cubic, wrap_angle};
+use super::{
+    IkBranch, IkBranches, Leg1, Leg1Equations, solve, working, working_by_cubic, wrap_angle,
+};
 use crate::certificate::Certificate;
+use crate::machine::ik::machine_ik;
+use crate::machine::transforms::tool_pose_eq26;
+use crate::parallel_module::branches::Config;
+use crate::parallel_module::equations::ModulePose;
 use crate::selftest::hard_sets::random_geometries;
 use crate::spec::Machine;
 use crate::tolerance::NEWTON_STEP_STOP;
@@ -148,10 +154,13 @@ fn a_point_gets_the_same_bits_alone_and_side_by_side() {
 /// The complete solver finds the branches on that posture with both roots of (12), z - R2
 /// sin(alpha) -+ h (h = 0 for the last two), on five machines (115 points built, where leg III
 /// reaches too): a reachable leg is never called out of reach, however little room it has.
+/// Each branch is listed once: where the two roots meet (the argument below zero, h = 0) leg II
+/// shows one, labelled -1, not the same branch twice.
 #[test]
 fn a_stretched_outer_leg_still_reaches() {
     let mut built = 0;
     for m in machines() {
+        let mut points = Vec::new();
         let g = &m.module;
         let (r, rr) = (g.r_big1, g.r_small1);
         let k0 = g.l1 * g.l1 - r * r - rr * rr;
@@ -202,16 +211,38 @@ fn a_stretched_outer_leg_still_reaches() {
                     continue; // leg III cannot reach: no branch on this posture
                 }
                 built += 1;
+                points.push(p);
                 // Both roots of (12) on the posture, each with (rho2 - off2)^2 = h^2 to the
                 // rounding of the square root's argument (terms of L2^2, here and in the test's
                 // construction: 64 eps L2^2, about 1.3e-8 mm^2).
                 let off2 = z - g.r_big2 * s;
                 let full = solve(&m, &p);
-                let rho2: Vec<f64> = full
+                let on_posture: Vec<&IkBranch> = full
                     .iter()
                     .filter(|b| (b.alpha - alpha).abs() < 1e-9 && (b.rho.x - rho1).abs() < 1e-6)
-                    .map(|b| b.rho.y)
                     .collect();
+                let rho2: Vec<f64> = on_posture.iter().map(|b| b.rho.y).collect();
+                let what = format!("{}: {p:?}, h {h:e}: {full:?}", m.name);
+                let configs: Vec<Config> = on_posture.iter().map(|b| b.config).collect();
+                assert_each_once(&configs, room < 0.0, &what);
+                if room < 0.0 {
+                    // The machine's branches at that module pose (theta1 = theta2 = 0, the tool
+                    // pose by eq. (26)): the same, once each.
+                    let module = ModulePose { p, alpha };
+                    let pose = tool_pose_eq26(&m.table, &module, 0.0, 0.0, m.tool_length);
+                    let machine = machine_ik(&m, &pose, m.tool_length);
+                    let configs: Vec<Config> = machine
+                        .iter()
+                        .filter(|b| {
+                            b.theta1.abs() < 1e-9
+                                && (b.alpha - alpha).abs() < 1e-9
+                                && (b.rho.x - rho1).abs() < 1e-6
+                        })
+                        .map(|b| b.config)
+                        .collect();
+                    assert!(!configs.is_empty(), "{what}: machine {machine:?}");
+                    assert_each_once(&configs, true, &format!("{what}: machine {machine:?}"));
+                }
                 let root = |below: bool| {
                     rho2.iter().any(|&r2| {
                         ((r2 - off2).powi(2) - h * h).abs() <= 64.0 * f64::EPSILON * g.l2 * g.l2
@@ -229,8 +260,30 @@ fn a_stretched_outer_leg_still_reaches() {
                 );
             }
         }
+        // A file's points, four side by side (the lanes' branches), give the same lists.
+        for baseline in [false, true] {
+            let mut lists = vec![IkBranches::new(); points.len()];
+            let rows = points.iter().copied().zip(lists.iter_mut());
+            if baseline {
+                super::solve_each_baseline(&m, rows);
+            } else {
+                super::solve_each(&m, rows);
+            }
+            for (p, list) in points.iter().zip(&lists) {
+                assert_eq!(list[..], solve(&m, p)[..], "{}: {p:?}", m.name);
+            }
+        }
     }
     assert!(built >= 100, "{built}");
+}
+
+/// No two of one posture's branches share a configuration (each branch once), and where the
+/// two roots of (12) meet (`leg2_meets`) leg II shows only s2 = -1.
+fn assert_each_once(configs: &[Config], leg2_meets: bool, what: &str) {
+    for (k, c) in configs.iter().enumerate() {
+        assert!(!configs[..k].contains(c), "{c:?} twice: {what}");
+        assert!(!leg2_meets || c[1] == -1, "{c:?}: {what}");
+    }
 }
 
 /// Points off the degenerate sets (the grid above) have their roots of eq. (9) proved simple in
