@@ -37,9 +37,13 @@ use crate::tolerance::{
 pub use branch::{IkBranch, IkBranches, MAX_IK_BRANCHES};
 pub(crate) use branch::{Leg1, distinct_branches, posture_order};
 
-/// The cubic eq. (9) in cos(alpha) for the point, normalised, lowest degree first; None when it
-/// is degenerate (every coefficient zero or not finite).
+/// The cubic eq. (9) in cos(alpha) for the point, normalised, lowest degree first; None for a
+/// point that is not finite, and when the cubic is degenerate (every coefficient zero) or
+/// overflows.
 pub fn cubic_eq9(g: &ModuleGeometry, p: &Vector3<f64>) -> Option<[f64; 4]> {
+    if !p.iter().all(|v| v.is_finite()) {
+        return None;
+    }
     let c = eq9_coefficients(g, p);
     let scale = c.iter().fold(0.0f64, |m, a| m.max(a.abs()));
     if scale == 0.0 || !scale.is_finite() {
@@ -940,10 +944,7 @@ pub fn working_fast(m: &Machine, p: &Vector3<f64>) -> Option<IkBranch> {
 /// of the cubic (9) above r1/R1, each polished, with the same margins.
 fn working_by_cubic(m: &Machine, p: &Vector3<f64>) -> Option<IkBranch> {
     let g = &m.module;
-    if !p.iter().all(|v| v.is_finite()) {
-        return None;
-    }
-    let coeffs = cubic_eq9(g, p)?;
+    let coeffs = cubic_eq9(g, p)?; // None for a point that is not finite
     let (r, rr) = (g.r_big1, g.r_small1);
     let lo = (rr / r - FAST_MARGIN_RAD).max(-1.0);
     let cos_tilt = cos_tilt_max(m);

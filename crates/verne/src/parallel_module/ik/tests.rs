@@ -347,6 +347,38 @@ fn eq9_error_bounds_are_the_magnitudes_and_hold() {
     eprintln!("worst error / bound: {worst:e}");
 }
 
+/// The public cubic of eq. (9) is the coefficients divided by the largest magnitude (the same
+/// ratios, the largest 1); none for a point that is not finite (z_p is not in eq. (9), and with
+/// NaN in x_p the coefficients of y_p alone stay finite, so the coefficients do not tell) nor
+/// for one so far that the coefficients overflow.
+#[test]
+fn cubic_eq9_is_normalised_and_refuses_a_point_not_finite() {
+    use super::{cubic_eq9, eq9_coefficients};
+    for m in machines() {
+        let g = &m.module;
+        for p in grid(6) {
+            let (c, cubic) = (eq9_coefficients(g, &p), cubic_eq9(g, &p).expect("a cubic"));
+            let largest = cubic.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+            assert_eq!(largest, 1.0, "{}: {p:?}: {cubic:?}", m.name);
+            let scale = c.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+            assert_eq!(cubic, c.map(|a| a / scale), "{}: {p:?}", m.name);
+        }
+        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            for i in 0..3 {
+                let mut p = Vector3::new(-250.0, 100.0, 1000.0);
+                p[i] = bad;
+                assert_eq!(cubic_eq9(g, &p), None, "{}: {p:?}", m.name);
+            }
+        }
+        for far in [
+            Vector3::new(1e200, 0.0, 0.0),
+            Vector3::new(0.0, -1e200, 0.0),
+        ] {
+            assert_eq!(cubic_eq9(g, &far), None, "{}: {far:?}", m.name);
+        }
+    }
+}
+
 // ------------------------------------------------------------- Newton's and Chebyshev's steps
 
 /// A point and one of its leg-I postures.
