@@ -286,6 +286,28 @@ fn assert_each_once(configs: &[Config], leg2_meets: bool, what: &str) {
     }
 }
 
+/// Every branch's alpha is in (-pi, pi], also at and next to alpha = pi: at y_p = 0 eq. (9) is
+/// (c^2 - 1) (2 R1^3 r1 c + R1^2 (k0 - u^2)) (k0 = L1^2 - R1^2 - r1^2, u = x_p + D1 - d1), so
+/// cos(alpha) = -1 is a root for every point, and a polish from alpha = pi, or the mirror image
+/// of a posture there, lands on either side of the turn.
+#[test]
+fn alpha_stays_in_the_half_open_turn_next_to_pi() {
+    let mut near_pi = 0;
+    for m in machines() {
+        let g = &m.module;
+        for x in [-200.0, -80.0, 0.0, 60.0, 150.0].map(|v| v - g.dx1) {
+            for y in [0.0, 1e-12, -1e-12, 1e-10, -1e-10, 1e-8, -1e-8, 1e-6, -1e-6] {
+                let p = Vector3::new(x, y, 1000.0);
+                for b in &solve(&m, &p) {
+                    assert!(b.alpha > -PI && b.alpha <= PI, "{}: {p:?}: {b:?}", m.name);
+                    near_pi += (PI - b.alpha.abs() < 1e-3) as usize;
+                }
+            }
+        }
+    }
+    assert!(near_pi >= 100, "{near_pi} branches next to alpha = pi");
+}
+
 /// Points off the degenerate sets (the grid above) have their roots of eq. (9) proved simple in
 /// double precision: the certificate is `Double`, no root goes to the factors of leg I (which
 /// a bound on the coefficients' error made too large would send them to).
