@@ -109,6 +109,12 @@ fn a_stream_follows_its_program_and_a_perturbed_sample_is_found_at_its_line() {
         checks_besides_acceleration(&rows).is_empty(),
         "{rows:?}\n{err}"
     );
+    // The samples are timed by the period: the speed changed at a corner within one period is
+    // reported (so speeds are checked).
+    assert!(
+        rows.iter().any(|r| r.contains(",acceleration,")),
+        "{rows:?}\n{err}"
+    );
     // The contour error of the clean stream is at rounding level.
     let tip_line = err.lines().find(|l| l.starts_with("tip_error")).unwrap();
     let worst: f64 = tip_line.split_whitespace().nth(2).unwrap().parse().unwrap();

@@ -491,4 +491,245 @@ mod tests {
             .unwrap();
         assert!((n.distance - 2.0).abs() < 1e-9, "{}", n.distance);
     }
+
+    /// A segment between two random poses (tilts up to 60 degrees, any phi2) and a sample off
+    /// it: its tip up to 5 mm away, its angles up to 10 degrees away.
+    fn random_case(unit: &mut impl FnMut() -> f64) -> (ContourPath, Vector3<f64>, f64, f64) {
+        let mut pose = || {
+            let tilt = 120.0 * unit() - 60.0;
+            let phi2 = 360.0 * unit() - 180.0;
+            point(100.0 * unit(), 100.0 * unit(), 100.0 * unit(), tilt, phi2)
+        };
+        let path = ContourPath::new(vec![pose(), pose()]);
+        let (a, b) = (&path.nodes[0], &path.nodes[1]);
+        let u = 1.4 * unit() - 0.2;
+        let off = Vector3::new(unit() - 0.5, unit() - 0.5, unit() - 0.5) * 10.0;
+        let tip = a.tip + u * (b.tip - a.tip) + off;
+        let (p1, p2) = path.segments[0].at(u.clamp(0.0, 1.0));
+        let (d1, d2) = (
+            (20.0 * unit() - 10.0).to_radians(),
+            (20.0 * unit() - 10.0).to_radians(),
+        );
+        (path, tip, p1 + d1, p2 + d2)
+    }
+
+    /// The projection that picks the segment is the nearest point of the segment in its own
+    /// coordinates (X Y Z and the angles weighted, phi2 by the segment's mean |sin(phi1)|):
+    /// its parameter is a brute-force search's (20,001 points) to the grid's spacing; a sample
+    /// on the segment projects to itself at distance 0, and one moved across the line of tips
+    /// (angles unchanged) is that far.
+    #[test]
+    fn the_projection_is_the_nearest_point_in_its_coordinates() {
+        let mut unit = crate::math::test_rng::lcg(0x5eed_c047);
+        let w = ANGLE_WEIGHT_MM_PER_RAD;
+        for _ in 0..400 {
+            let (path, tip, phi1, phi2) = random_case(&mut unit);
+            let seg = path.segments[0];
+            let (a, b) = (path.nodes[0], path.nodes[1]);
+            let coords = |x: Vector3<f64>, p1: f64, p2: f64| {
+                SVector::<f64, 5>::new(x.x, x.y, x.z, w * p1, w * seg.s * p2)
+            };
+            let q = coords(tip, phi1, seg.a.1 + wrap_angle(phi2 - seg.a.1));
+            let gap = |u: f64| {
+                let (p1, p2) = seg.at(u);
+                (q - coords(a.tip + u * (b.tip - a.tip), p1, p2)).norm()
+            };
+            let brute = (0..=20_000)
+                .map(|i| i as f64 / 20_000.0)
+                .min_by(|x, y| gap(*x).total_cmp(&gap(*y)))
+                .unwrap();
+            let (u, _) = path.project(0, &seg, &tip, (phi1, phi2));
+            assert!(
+                gap(u) <= gap(brute) + 1e-9 && (u - brute).abs() <= 1e-3,
+                "u {u} ({}), brute force {brute} ({})",
+                gap(u),
+                gap(brute)
+            );
+            // On the segment, then moved across the line of tips by 0.7 mm.
+            let v = unit();
+            let (p1, p2) = seg.at(v);
+            let on = a.tip + v * (b.tip - a.tip);
+            let (u, d) = path.project(0, &seg, &on, (p1, p2));
+            assert!((u - v).abs() <= 1e-9 && d <= 1e-9, "{v}: {u} {d}");
+            let along = (b.tip - a.tip).normalize();
+            let across = along
+                .cross(&Vector3::new(unit(), unit(), unit()))
+                .normalize()
+                * 0.7;
+            let (u, d) = path.project(0, &seg, &(on + across), (p1, p2));
+            assert!(
+                (u - v).abs() <= 1e-9 && (d - 0.7).abs() <= 1e-9,
+                "{v}: {u} {d}"
+            );
+        }
+    }
+
+    /// The point reported on the segment is the nearest by the distance that counts (tips, and
+    /// the angle between the axes weighted), which the projection only approximates: no point
+    /// of a brute-force search (20,001 points) is nearer, and on these segments the projection's
+    /// own parameter alone is often farther (the golden-section refinement is what finds it).
+    #[test]
+    fn the_nearest_point_is_a_brute_force_searchs_on_the_axes() {
+        let mut unit = crate::math::test_rng::lcg(0x5eed_c048);
+        let mut refined = 0;
+        for _ in 0..400 {
+            let (path, tip, phi1, phi2) = random_case(&mut unit);
+            let seg = path.segments[0];
+            let axis = tool_axis(phi1, phi2);
+            let distance = |u: f64| {
+                let p = path.at(0, &seg, u);
+                let angle = p.axis.dot(&axis).clamp(-1.0, 1.0).acos();
+                ((tip - p.tip).norm_squared() + (ANGLE_WEIGHT_MM_PER_RAD * angle).powi(2)).sqrt()
+            };
+            let brute = (0..=20_000)
+                .map(|i| distance(i as f64 / 20_000.0))
+                .fold(f64::MAX, f64::min);
+            let (u0, _) = path.project(0, &seg, &tip, (phi1, phi2));
+            let n = path.clone().nearest(&tip, phi1, phi2).unwrap();
+            assert!(
+                n.distance <= brute + 1e-9 && (n.distance - distance(n.u)).abs() <= 1e-9,
+                "{} at {} vs brute force {brute}",
+                n.distance,
+                n.u
+            );
+            assert!(
+                ((n.point.tip - tip).norm() - (path.at(0, &seg, n.u).tip - tip).norm()).abs()
+                    < 1e-12
+            );
+            refined += (distance(u0) > n.distance + 1e-6) as usize;
+        }
+        assert!(
+            refined >= 40,
+            "{refined} of 400 refined past the projection"
+        );
+    }
+
+    /// The search window: a sample within [`WINDOW_TRUST_MM`] of a segment near the previous
+    /// sample's stays on it, even where another part of the path is nearer (a path that comes
+    /// back 0.6 mm beside itself, the nearer part 400 segments away); a sample farther than that
+    /// from the window is found on the whole path; an empty path has no nearest point.
+    #[test]
+    fn a_sample_stays_on_the_part_of_the_path_it_follows() {
+        let out = (0..=400).map(|k| point(k as f64, 0.0, 100.0, 10.0, 0.0));
+        let back = (0..=400)
+            .rev()
+            .map(|k| point(k as f64, 0.6, 100.0, 10.0, 0.0));
+        let points: Vec<PathPoint> = out.chain(back).collect();
+        let mut path = ContourPath::new(points);
+        assert_eq!((path.len(), path.is_empty()), (802, false));
+        let a = 10f64.to_radians();
+        // Along the way out, round the turn (segment 400), then back (segment 401 + j from x =
+        // 400 - j to 399 - j): samples 0.25 mm from the way back (0.35 from the way out), and
+        // where the way out is beyond the window (more than 64 segments away in the path, x
+        // below 360), samples 0.25 mm from the way out, still found on the way back.
+        // The way out at y = 0.35 (0.25 from the way back, far behind in the path): followed.
+        for k in 0..330 {
+            let x = 0.5 + k as f64;
+            let n = path.nearest(&Vector3::new(x, 0.35, 100.0), a, 0.0).unwrap();
+            assert_eq!(n.segment, k, "{x}: {n:?}");
+            assert!((n.distance - 0.35).abs() < 1e-9, "{x}: {n:?}");
+        }
+        for (x, y, segment) in [(395.5, 0.0, 395), (399.5, 0.0, 399), (399.5, 0.6, 401)] {
+            let n = path.nearest(&Vector3::new(x, y, 100.0), a, 0.0).unwrap();
+            assert_eq!(n.segment, segment, "{x} {y}");
+        }
+        let mut beside = 0;
+        for k in 0..399 {
+            let x = 398.5 - k as f64;
+            let n = path.nearest(&Vector3::new(x, 0.35, 100.0), a, 0.0).unwrap();
+            assert_eq!(n.segment, 402 + k, "{x}: {n:?}");
+            assert!((n.distance - 0.25).abs() < 1e-9, "{x}: {n:?}");
+            if x < 360.0 {
+                let n = path.nearest(&Vector3::new(x, 0.25, 100.0), a, 0.0).unwrap();
+                assert_eq!(n.segment, 402 + k, "{x}: {n:?}");
+                assert!((n.distance - 0.35).abs() < 1e-9, "{x}: {n:?}");
+                beside += 1;
+            }
+        }
+        assert_eq!(beside, 360);
+        // 2 mm off the path near its start, the window at the path's end (the way back's start
+        // there is 2.6 mm away): beyond the trust of the window, searched whole.
+        let n = path
+            .nearest(&Vector3::new(3.5, -2.0, 100.0), a, 0.0)
+            .unwrap();
+        assert_eq!(n.segment, 3);
+        assert!((n.distance - 2.0).abs() < 1e-9);
+        let mut empty = ContourPath::new(Vec::new());
+        assert_eq!((empty.len(), empty.is_empty()), (0, true));
+        assert_eq!(empty.nearest(&Vector3::zeros(), 0.0, 0.0), None);
+    }
+
+    /// Two parts of a path with the same tips and different tool angles (tilted 10 degrees on
+    /// the way out, 30 on the way back, over the same line): the sample's angles pick the part,
+    /// given in either orientation solution (phi1, phi2) or (-phi1, phi2 + 180 degrees); a
+    /// difference of phi2 counts by sin(phi1), as the angle between the axes does.
+    #[test]
+    fn the_tool_angles_pick_between_parts_with_the_same_tips() {
+        let out = (0..=10).map(|k| point(k as f64, 0.0, 100.0, 10.0, 30.0));
+        let back = (0..=10)
+            .rev()
+            .map(|k| point(k as f64, 0.0, 100.0, 30.0, 30.0));
+        let points: Vec<PathPoint> = out.chain(back).collect();
+        for (tilt, first) in [(10.0, 0), (30.0, 11)] {
+            for (phi1, phi2) in [(tilt, 30.0), (-tilt, -150.0)] {
+                let mut path = ContourPath::new(points.clone());
+                let tip = Vector3::new(6.5, 0.0, 100.0);
+                let n = path
+                    .nearest(&tip, f64::to_radians(phi1), f64::to_radians(phi2))
+                    .unwrap();
+                let part = if first == 0 { 6 } else { 14 };
+                assert_eq!(n.segment, part, "{phi1} {phi2}: {n:?}");
+                assert!(n.distance < 1e-9, "{phi1} {phi2}: {n:?}");
+            }
+        }
+        // Parts 0.6 mm apart, tilted 10 degrees, phi2 0 on the way out and 3 degrees back: a
+        // sample on the way out's tips with the way back's angles is nearer the way out (its
+        // axis 3 sin(10) = 0.52 degrees off, 0.52 mm weighted) than the way back (0.6 mm).
+        let out = (0..=10).map(|k| point(k as f64, 0.0, 100.0, 10.0, 0.0));
+        let back = (0..=10)
+            .rev()
+            .map(|k| point(k as f64, 0.6, 100.0, 10.0, 3.0));
+        let mut path = ContourPath::new(out.chain(back).collect());
+        let n = path
+            .nearest(
+                &Vector3::new(5.5, 0.0, 100.0),
+                10f64.to_radians(),
+                3f64.to_radians(),
+            )
+            .unwrap();
+        let off = tool_axis(10f64.to_radians(), 0.0)
+            .angle(&tool_axis(10f64.to_radians(), 3f64.to_radians()));
+        assert_eq!(n.segment, 5, "{n:?}");
+        assert!(
+            (n.distance - ANGLE_WEIGHT_MM_PER_RAD * off).abs() < 1e-9,
+            "{n:?}"
+        );
+        assert!((n.distance - 0.52).abs() < 0.01, "{n:?}");
+    }
+
+    /// A path of one point is a segment from it to itself: every sample is nearest to it, at
+    /// parameter 0, by its distance from it (the projection divides by nothing).
+    #[test]
+    fn a_path_of_one_point_is_that_point() {
+        let mut path = ContourPath::new(vec![point(10.0, 20.0, 30.0, 15.0, 40.0)]);
+        assert_eq!(path.len(), 1);
+        let n = path
+            .nearest(
+                &Vector3::new(13.0, 24.0, 30.0),
+                15f64.to_radians(),
+                40f64.to_radians(),
+            )
+            .unwrap();
+        assert_eq!((n.segment, n.u), (0, 0.0));
+        assert!((n.distance - 5.0).abs() < 1e-12, "{n:?}");
+        // The same axis in the other orientation solution: the same distance.
+        let m = path
+            .nearest(
+                &Vector3::new(13.0, 24.0, 30.0),
+                -15f64.to_radians(),
+                -140f64.to_radians(),
+            )
+            .unwrap();
+        assert!((m.distance - 5.0).abs() < 1e-9, "{m:?}");
+    }
 }
