@@ -493,7 +493,7 @@ mod tests {
     }
 
     /// A segment between two random poses (tilts up to 60 degrees, any phi2) and a sample off
-    /// it: its tip up to 5 mm away, its angles up to 10 degrees away.
+    /// it: each coordinate of its tip up to 5 mm off, its angles up to 10 degrees off.
     fn random_case(unit: &mut impl FnMut() -> f64) -> (ContourPath, Vector3<f64>, f64, f64) {
         let mut pose = || {
             let tilt = 120.0 * unit() - 60.0;
@@ -604,32 +604,42 @@ mod tests {
         );
     }
 
-    /// The search window: a sample within [`WINDOW_TRUST_MM`] of a segment near the previous
-    /// sample's stays on it, even where another part of the path is nearer (a path that comes
-    /// back 0.6 mm beside itself, the nearer part 400 segments away); a sample farther than that
-    /// from the window is found on the whole path; an empty path has no nearest point.
+    /// The search window: a sample within [`WINDOW_TRUST_MM`] of a segment within
+    /// [`SEARCH_WINDOW`] segments of the previous sample's stays there, even where another part
+    /// of the path is nearer (a path that comes back 0.6 mm beside itself, the nearer part more
+    /// than 64 segments away), and goes to that part once it is 64 away; a sample farther than
+    /// the trust from the window is found on the whole path; an empty path has no nearest point.
     #[test]
     fn a_sample_stays_on_the_part_of_the_path_it_follows() {
+        // The way out (segments 0 to 399), a turn of two segments, the way back 0.6 mm beside
+        // (segment 402 + j from x = 400 - j to 399 - j: beside x = k + 0.5, segment 801 - k).
         let out = (0..=400).map(|k| point(k as f64, 0.0, 100.0, 10.0, 0.0));
+        let turn = std::iter::once(point(400.0, 0.3, 100.0, 10.0, 0.0));
         let back = (0..=400)
             .rev()
             .map(|k| point(k as f64, 0.6, 100.0, 10.0, 0.0));
-        let points: Vec<PathPoint> = out.chain(back).collect();
+        let points: Vec<PathPoint> = out.chain(turn).chain(back).collect();
         let mut path = ContourPath::new(points);
-        assert_eq!((path.len(), path.is_empty()), (802, false));
+        assert_eq!((path.len(), path.is_empty()), (803, false));
         let a = 10f64.to_radians();
-        // Along the way out, round the turn (segment 400), then back (segment 401 + j from x =
-        // 400 - j to 399 - j): samples 0.25 mm from the way back (0.35 from the way out), and
-        // where the way out is beyond the window (more than 64 segments away in the path, x
-        // below 360), samples 0.25 mm from the way out, still found on the way back.
-        // The way out at y = 0.35 (0.25 from the way back, far behind in the path): followed.
-        for k in 0..330 {
+        // The way out at y = 0.35 (0.25 from the way back): followed while the way back there is
+        // beyond the window (802 - 2 k segments past the previous sample's, 66 at k = 368); at
+        // k = 369 it is 64 past, inside the window, and the sample goes to it.
+        for k in 0..369 {
             let x = 0.5 + k as f64;
             let n = path.nearest(&Vector3::new(x, 0.35, 100.0), a, 0.0).unwrap();
             assert_eq!(n.segment, k, "{x}: {n:?}");
             assert!((n.distance - 0.35).abs() < 1e-9, "{x}: {n:?}");
         }
-        for (x, y, segment) in [(395.5, 0.0, 395), (399.5, 0.0, 399), (399.5, 0.6, 401)] {
+        let n = path
+            .nearest(&Vector3::new(369.5, 0.35, 100.0), a, 0.0)
+            .unwrap();
+        assert_eq!((n.segment, SEARCH_WINDOW), (432, 64), "{n:?}");
+        assert!((n.distance - 0.25).abs() < 1e-9, "{n:?}");
+        // Along the way out, round the turn, then back: samples 0.25 mm from the way back (0.35
+        // from the way out), and where the way out is beyond the window (x below 360), samples
+        // 0.25 mm from the way out, still found on the way back.
+        for (x, y, segment) in [(395.5, 0.0, 395), (399.5, 0.0, 399), (399.5, 0.6, 402)] {
             let n = path.nearest(&Vector3::new(x, y, 100.0), a, 0.0).unwrap();
             assert_eq!(n.segment, segment, "{x} {y}");
         }
@@ -637,11 +647,11 @@ mod tests {
         for k in 0..399 {
             let x = 398.5 - k as f64;
             let n = path.nearest(&Vector3::new(x, 0.35, 100.0), a, 0.0).unwrap();
-            assert_eq!(n.segment, 402 + k, "{x}: {n:?}");
+            assert_eq!(n.segment, 403 + k, "{x}: {n:?}");
             assert!((n.distance - 0.25).abs() < 1e-9, "{x}: {n:?}");
             if x < 360.0 {
                 let n = path.nearest(&Vector3::new(x, 0.25, 100.0), a, 0.0).unwrap();
-                assert_eq!(n.segment, 402 + k, "{x}: {n:?}");
+                assert_eq!(n.segment, 403 + k, "{x}: {n:?}");
                 assert!((n.distance - 0.35).abs() < 1e-9, "{x}: {n:?}");
                 beside += 1;
             }
