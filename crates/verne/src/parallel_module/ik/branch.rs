@@ -48,6 +48,33 @@ pub(crate) fn distinct_branches(four: [IkBranch; 4]) -> ([IkBranch; 4], usize) {
     }
 }
 
+/// Pushes the distinct branches among one posture's four ([`distinct_branches`]) onto `out`;
+/// false when they do not fit. The usual case, four distinct branches, is one fixed-size copy:
+/// a copy of a variable `n` branches made the complete solver (`ik/all_branches` in
+/// docs/benchmarks.md) a quarter slower.
+#[inline(always)]
+pub(crate) fn push_distinct(
+    out: &mut arrayvec::ArrayVec<IkBranch, MAX_IK_BRANCHES>,
+    four: [IkBranch; 4],
+) -> bool {
+    let config = four[0].config;
+    if config != four[1].config && config != four[2].config {
+        return out.try_extend_from_slice(&four).is_ok();
+    }
+    push_meeting(out, four)
+}
+
+/// [`push_distinct`] where a leg's two roots meet (a stretched outer leg: rare).
+#[cold]
+#[inline(never)]
+fn push_meeting(
+    out: &mut arrayvec::ArrayVec<IkBranch, MAX_IK_BRANCHES>,
+    four: [IkBranch; 4],
+) -> bool {
+    let (four, n) = distinct_branches(four);
+    out.try_extend_from_slice(&four[..n]).is_ok()
+}
+
 /// A leg-I posture: an orientation alpha and the slider-1 position that goes with it.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Leg1 {

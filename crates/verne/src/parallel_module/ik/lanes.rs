@@ -12,7 +12,7 @@ use std::arch::x86_64::*;
 
 use nalgebra::Vector3;
 
-use super::branch::{IkBranch, IkBranches, Leg1, distinct_branches, posture_order};
+use super::branch::{IkBranch, IkBranches, Leg1, posture_order, push_distinct};
 use crate::parallel_module::branches::{Reason, Verdict};
 use crate::parallel_module::equations::Sliders;
 use crate::spec::Machine;
@@ -51,12 +51,11 @@ pub(crate) unsafe fn branches_into(
             config: [s1[k], s2[k2], s3[k3]],
             verdict: Verdict::from_bits(lanes.verdict[2 * k2 + k3][k] as u16),
         };
-        let (four, n) = distinct_branches([branch(0, 0), branch(0, 1), branch(1, 0), branch(1, 1)]);
-        let pushed = out.try_extend_from_slice(&four[..n]);
-        debug_assert!(
-            pushed.is_ok(),
-            "four postures of four branches fit MAX_IK_BRANCHES"
+        let pushed = push_distinct(
+            out,
+            [branch(0, 0), branch(0, 1), branch(1, 0), branch(1, 1)],
         );
+        debug_assert!(pushed, "four postures of four branches fit MAX_IK_BRANCHES");
     }
 }
 

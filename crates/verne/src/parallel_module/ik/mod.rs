@@ -35,7 +35,7 @@ use crate::tolerance::{
 };
 
 pub use branch::{IkBranch, IkBranches, MAX_IK_BRANCHES};
-pub(crate) use branch::{Leg1, distinct_branches, posture_order};
+pub(crate) use branch::{Leg1, distinct_branches, posture_order, push_distinct};
 
 /// The cubic eq. (9) in cos(alpha) for the point, normalised, lowest degree first; None for a
 /// point that is not finite, and when the cubic is degenerate (every coefficient zero) or
@@ -831,12 +831,8 @@ fn branches_into(m: &Machine, p: &Vector3<f64>, legs1: &ArrayVec<Leg1, 6>, out: 
     let (order, n) = posture_order(legs1, &s1);
     for &k in &order[..n] {
         if let Some(o) = &outer[k] {
-            let (four, n) = distinct_branches(four_branches(m, p, &legs1[k], checks[k], o));
-            let pushed = out.try_extend_from_slice(&four[..n]);
-            debug_assert!(
-                pushed.is_ok(),
-                "six postures of four branches fit MAX_IK_BRANCHES"
-            );
+            let pushed = push_distinct(out, four_branches(m, p, &legs1[k], checks[k], o));
+            debug_assert!(pushed, "six postures of four branches fit MAX_IK_BRANCHES");
         }
     }
 }
