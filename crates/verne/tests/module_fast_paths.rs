@@ -597,3 +597,50 @@ fn the_tracker_answers_only_within_its_certified_radius() {
         assert!((w.pose.p - e.pose.p).amax() < 1e-9 && (w.pose.alpha - e.pose.alpha).abs() < 1e-12);
     }
 }
+
+/// The tracker's certified radius is the one its module documentation derives, to half a
+/// percent: with beta the Frobenius norm of J(q*)^-1 in the scaled pose (alpha's row times the
+/// platform radius R) and L = 4 (3 + max L_i / R), a row may move the pose by CERTIFIED_FRACTION
+/// (1/4) of 2 / (beta L). Moving the three sliders together by d moves the platform by d along
+/// z and leaves the rod vectors, so J and the radius, as they are; a jump of 0.995 of the radius
+/// is tracked, one of 1.005 is sent to the complete solution.
+#[test]
+fn the_trackers_certified_radius_is_the_documented_one() {
+    use verne::parallel_module::equations::jacobian_pose;
+    let m = Machine::default_verne();
+    let g = &m.module;
+    let radius = g.r_big1.max(g.r_big2);
+    let lipschitz = 4.0 * (3.0 + g.l1.max(g.l2).max(g.l3) / radius);
+    for rho0 in [
+        Sliders::new(368.354796, 84.956547, 179.032689),
+        Sliders::new(300.0, 120.0, 150.0),
+        Sliders::new(420.0, 60.0, 240.0),
+    ] {
+        let start = *fk::working(&fk::solve(&m, &rho0)).expect("a working mode");
+        let inv = jacobian_pose(g, &start.pose, &rho0).try_inverse().unwrap();
+        let beta = (0..4)
+            .flat_map(|i| (0..4).map(move |j| (i, j)))
+            .map(|(i, j)| (inv[(i, j)] * if i == 3 { radius } else { 1.0 }).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        let certified = 0.25 * 2.0 / (beta * lipschitz);
+        assert!(certified > 1.0, "{certified} mm at {rho0:?}");
+        for (fraction, tracked) in [(0.995, true), (1.005, false)] {
+            let jump = fraction * certified;
+            let mut t = FkTracker::new(&m);
+            let mut out = FkModes::default();
+            t.working_into(&rho0, &mut out);
+            let rho = rho0 + Sliders::new(jump, jump, jump);
+            t.working_into(&rho, &mut out);
+            assert_eq!(
+                (t.tracked, t.solved),
+                if tracked { (1, 1) } else { (0, 2) },
+                "a jump of {jump} mm ({fraction} of the radius {certified}) at {rho0:?}"
+            );
+            let w = fk::working(&out).unwrap();
+            assert!((w.pose.p.z - start.pose.p.z - jump).abs() < 1e-9);
+            assert!((w.pose.p.xy() - start.pose.p.xy()).amax() < 1e-9);
+            assert!((w.pose.alpha - start.pose.alpha).abs() < 1e-12);
+        }
+    }
+}
