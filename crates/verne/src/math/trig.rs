@@ -1166,6 +1166,47 @@ mod tests {
         }
     }
 
+    /// From alpha = 0 the step's sine is the series' sin d alone, so there the series are
+    /// checked relative to sin d, not to 1: within two roundings of the library's sine for steps
+    /// from 1e-9 to [`SMALL_ANGLE`] (a fifth-order term of sin d dropped is 1e-16 of it at
+    /// d = 1e-3, hundreds of roundings).
+    #[test]
+    fn the_series_of_a_small_step_are_exact_relative_to_it() {
+        let mut unit = crate::math::test_rng::lcg(0x5e71_e5d0);
+        for _ in 0..20_000 {
+            let scale = [1e-9, 1e-5, 9.99e-4, 1.01e-3, 0.1, 0.2499][(unit() * 6.0) as usize];
+            let d = (2.0 * unit() - 1.0) * scale;
+            let (s, c) = sin_cos_after_step(0.0, 1.0, -d, d);
+            let (ls, lc) = (-d).sin_cos();
+            assert!(
+                (s - ls).abs() <= 2.0 * f64::EPSILON * ls.abs()
+                    && (c - lc).abs() <= 2.0 * f64::EPSILON,
+                "0 - {d}: ({s}, {c}) vs ({ls}, {lc})"
+            );
+        }
+    }
+
+    /// [`Trig::at_grid`] is [`Trig::on_grid`] at one point, bit for bit (the isolation takes F
+    /// from one and F' and F'' from the other at the same points).
+    #[test]
+    fn at_grid_is_on_grid_bit_for_bit() {
+        let mut unit = crate::math::test_rng::lcg(0x0a7_9e1d);
+        for _ in 0..200 {
+            let f = Trig {
+                cos: std::array::from_fn(|_| 2.0 * unit() - 1.0),
+                sin: std::array::from_fn(|k| if k == 0 { 0.0 } else { 2.0 * unit() - 1.0 }),
+            };
+            let all = f.on_grid();
+            for (j, v) in all.iter().enumerate() {
+                assert_eq!(
+                    f.at_grid(j).to_bits(),
+                    v.to_bits(),
+                    "{f:?} at grid point {j}"
+                );
+            }
+        }
+    }
+
     fn sample() -> Trig {
         Trig {
             cos: [0.3, -1.2, 0.7, 0.25, -0.4],
