@@ -147,35 +147,38 @@ fn a_point_gets_the_same_bits_alone_and_side_by_side() {
     }
 }
 
-/// A point whose leg II is stretched to within h = 1e-3 to 1e-5 mm, or fully (h = 0), or short
-/// by rounding noise (the square root's argument -1e-8 mm^2, within
-/// [`crate::tolerance::SQRT_ARG_REL`] L2^2 of zero): built from a leg-I posture (alpha, rho1)
-/// by eqs. (14) and (10), with y set by bisection so that leg II's argument in eq. (12) is that.
-/// The complete solver finds the branches on that posture with both roots of (12), z - R2
-/// sin(alpha) -+ h (h = 0 for the last two), on five machines (115 points built, where leg III
-/// reaches too): a reachable leg is never called out of reach, however little room it has.
-/// Each branch is listed once: where the two roots meet (the argument below zero, h = 0) leg II
-/// shows one, labelled -1, not the same branch twice.
+/// A point whose leg II (or leg III) is stretched to within h = 1e-3 to 1e-5 mm, or fully (h =
+/// 0), or short by rounding noise (the square root's argument -1e-8 mm^2, within
+/// [`crate::tolerance::SQRT_ARG_REL`] L^2 of zero): built from a leg-I posture (alpha, rho1) by
+/// eqs. (14) and (10), with y set by bisection so that the leg's argument in eq. (12) (or (13))
+/// is that. The complete solver finds the branches on that posture with both roots, z -+ R2
+/// sin(alpha) -+ h (h = 0 for the last two), on five machines (points built where the other
+/// outer leg reaches too): a reachable leg is never called out of reach, however little room it
+/// has. Each branch is listed once: where the two roots meet (the argument below zero, h = 0)
+/// the leg shows one, labelled -1, not the same branch twice.
 #[test]
 fn a_stretched_outer_leg_still_reaches() {
-    let mut built = 0;
+    let mut built = [0; 2];
     for m in machines() {
         let mut points = Vec::new();
         let g = &m.module;
         let (r, rr) = (g.r_big1, g.r_small1);
         let k0 = g.l1 * g.l1 - r * r - rr * rr;
-        for (alpha, u_sign) in [0.1, 0.25, 0.4, 0.55, -0.3, -0.5]
+        // The stretched leg: its index in a configuration and in the sliders (1: leg II, eq.
+        // (12); 2: leg III, eq. (13)), its length, and the sign of R2 in its equation.
+        for ((alpha, u_sign), (leg, l, l_other, sign)) in [0.1, 0.25, 0.4, 0.55, -0.3, -0.5]
             .into_iter()
             .flat_map(|a| [(a, 1.0), (a, -1.0)])
+            .flat_map(|a| [(a, (1, g.l2, g.l3, -1.0)), (a, (2, g.l3, g.l2, 1.0))])
         {
             let (s, c) = f64::sin_cos(alpha);
             let z = 1000.0;
-            // eq. (14) gives z - rho1 from y, eq. (10) u; then leg II's argument of (12).
+            // eq. (14) gives z - rho1 from y, eq. (10) u; then the leg's argument of (12) or (13).
             let point = |y: f64| {
                 let dz = -y * (r * c - rr) / (r * s);
                 let u2 = k0 + 2.0 * r * rr * c - y * y - dz * dz;
                 let x = u_sign * u2.max(0.0).sqrt() - g.dx1;
-                let arg = g.l2 * g.l2 - (x + g.dx2).powi(2) - (y - g.r_big2 * c + g.r4).powi(2);
+                let arg = l * l - (x + g.dx2).powi(2) - (y + sign * (g.r_big2 * c - g.r4)).powi(2);
                 (Vector3::new(x, y, z), z - dz, u2, arg)
             };
             for room in [1e-6f64, 1e-8, 1e-10, 0.0, -1e-8] {
@@ -206,25 +209,25 @@ fn a_stretched_outer_leg_still_reaches() {
                     }
                 }
                 let (p, rho1, _, _) = point(lo);
-                let dy3 = p.y + g.r_big2 * c - g.r4;
-                if g.l3 * g.l3 - (p.x + g.dx2).powi(2) - dy3 * dy3 < 1.0 {
-                    continue; // leg III cannot reach: no branch on this posture
+                let dy_other = p.y - sign * (g.r_big2 * c - g.r4);
+                if l_other * l_other - (p.x + g.dx2).powi(2) - dy_other * dy_other < 1.0 {
+                    continue; // the other outer leg cannot reach: no branch on this posture
                 }
-                built += 1;
+                built[leg - 1] += 1;
                 points.push(p);
-                // Both roots of (12) on the posture, each with (rho2 - off2)^2 = h^2 to the
-                // rounding of the square root's argument (terms of L2^2, here and in the test's
-                // construction: 64 eps L2^2, about 1.3e-8 mm^2).
-                let off2 = z - g.r_big2 * s;
+                // Both roots of (12) or (13) on the posture, each with (rho - off)^2 = h^2 to
+                // the rounding of the square root's argument (terms of L^2, here and in the
+                // test's construction: 64 eps L^2, about 1.3e-8 mm^2).
+                let off = z + sign * g.r_big2 * s;
                 let full = solve(&m, &p);
                 let on_posture: Vec<&IkBranch> = full
                     .iter()
                     .filter(|b| (b.alpha - alpha).abs() < 1e-9 && (b.rho.x - rho1).abs() < 1e-6)
                     .collect();
-                let rho2: Vec<f64> = on_posture.iter().map(|b| b.rho.y).collect();
+                let rho: Vec<f64> = on_posture.iter().map(|b| b.rho[leg]).collect();
                 let what = format!("{}: {p:?}, h {h:e}: {full:?}", m.name);
                 let configs: Vec<Config> = on_posture.iter().map(|b| b.config).collect();
-                assert_each_once(&configs, room < 0.0, &what);
+                assert_each_once(&configs, (room < 0.0).then_some(leg), &what);
                 if room < 0.0 {
                     // The machine's branches at that module pose (theta1 = theta2 = 0, the tool
                     // pose by eq. (26)): the same, once each.
@@ -241,21 +244,22 @@ fn a_stretched_outer_leg_still_reaches() {
                         .map(|b| b.config)
                         .collect();
                     assert!(!configs.is_empty(), "{what}: machine {machine:?}");
-                    assert_each_once(&configs, true, &format!("{what}: machine {machine:?}"));
+                    let what = format!("{what}: machine {machine:?}");
+                    assert_each_once(&configs, Some(leg), &what);
                 }
                 let root = |below: bool| {
-                    rho2.iter().any(|&r2| {
-                        ((r2 - off2).powi(2) - h * h).abs() <= 64.0 * f64::EPSILON * g.l2 * g.l2
+                    rho.iter().any(|&r| {
+                        ((r - off).powi(2) - h * h).abs() <= 64.0 * f64::EPSILON * l * l
                             && (if below {
-                                r2 <= off2 + 1e-9
+                                r <= off + 1e-9
                             } else {
-                                r2 >= off2 - 1e-9
+                                r >= off - 1e-9
                             })
                     })
                 };
                 assert!(
                     root(true) && root(false),
-                    "{}: {p:?}, h {h:e}: {off2} -+ h not in {full:?}",
+                    "{}: {p:?}, leg {leg}, h {h:e}: {off} -+ h not in {full:?}",
                     m.name
                 );
             }
@@ -274,15 +278,16 @@ fn a_stretched_outer_leg_still_reaches() {
             }
         }
     }
-    assert!(built >= 100, "{built}");
+    eprintln!("built (leg II, leg III): {built:?}");
+    assert!(built[0] >= 100 && built[1] >= 100, "{built:?}");
 }
 
 /// No two of one posture's branches share a configuration (each branch once), and where the
-/// two roots of (12) meet (`leg2_meets`) leg II shows only s2 = -1.
-fn assert_each_once(configs: &[Config], leg2_meets: bool, what: &str) {
+/// two roots of an outer leg meet (`meets`: 1 for leg II, 2 for leg III) it shows only -1.
+fn assert_each_once(configs: &[Config], meets: Option<usize>, what: &str) {
     for (k, c) in configs.iter().enumerate() {
         assert!(!configs[..k].contains(c), "{c:?} twice: {what}");
-        assert!(!leg2_meets || c[1] == -1, "{c:?}: {what}");
+        assert!(meets.is_none_or(|leg| c[leg] == -1), "{c:?}: {what}");
     }
 }
 
@@ -1044,4 +1049,36 @@ fn polish_converges_from_near_starts() {
             }
         }
     }
+}
+
+/// Every point's branches come out ordered by alpha (`total_cmp`), then configuration, as
+/// [`posture_order`](super::posture_order) promises: on grids of five machines, with the planes
+/// where its first guess (the mirrors, then the others in reverse) could be wrong: y = 0 and
+/// next to it (postures at alpha = 0 and at alpha = pi, each with both s1), and x, z across the
+/// workspace. (The guess is right on all of them: the sort after it is a safety net.)
+#[test]
+fn branches_come_out_by_alpha_then_configuration() {
+    let mut lists = 0;
+    for m in machines() {
+        let g = &m.module;
+        for x in [-300.0, -150.0, -40.0, 0.0, 90.0, 200.0].map(|v| v - g.dx1) {
+            for y in [
+                0.0, -0.0, 1e-12, -1e-12, 1e-6, -1e-6, 0.5, -0.5, 60.0, -60.0, 250.0,
+            ] {
+                for z in [600.0, 900.0, 1000.0, 1200.0] {
+                    let p = Vector3::new(x, y, z);
+                    let all = solve(&m, &p);
+                    lists += (all.len() > 1) as usize;
+                    for w in all.windows(2) {
+                        let order = w[0]
+                            .alpha
+                            .total_cmp(&w[1].alpha)
+                            .then(w[0].config.cmp(&w[1].config));
+                        assert!(order.is_lt(), "{}: {p:?}: {:?}", m.name, &all[..]);
+                    }
+                }
+            }
+        }
+    }
+    assert!(lists > 500, "{lists}");
 }
