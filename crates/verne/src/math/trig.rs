@@ -1108,6 +1108,32 @@ mod tests {
         }
     }
 
+    /// [`newton_bracketed`] keeps its steps inside the bracket: on g = atan(x - r) over [r - 1,
+    /// r + 5], from starts 1.5 to 4.9 past the root (past 1.39 Newton's steps on atan overshoot
+    /// further each time, and Chebyshev's too), both kinds of step find the root, to rounding,
+    /// by bisecting where a step leaves the bracket.
+    #[test]
+    fn bracketed_steps_that_would_diverge_bisect() {
+        for r in [-2.0, 0.0, 0.7] {
+            let eval = |x: f64| {
+                let v = x - r;
+                let w = 1.0 / (1.0 + v * v);
+                (v.atan(), w, -2.0 * v * w * w)
+            };
+            for start in [1.5, 2.0, 3.0, 4.9].map(|d| r + d) {
+                // |atan''| <= 3 sqrt(3) / 8, |atan'''| <= 2.
+                for m3 in [None, Some(2.0)] {
+                    let bounds = StepBounds { m2: 0.65, m3 };
+                    let x = newton_bracketed(r - 1.0, r + 5.0, (-1f64).atan(), start, bounds, eval);
+                    assert!(
+                        (x - r).abs() <= 4.0 * f64::EPSILON,
+                        "{r} from {start}, {m3:?}: {x}"
+                    );
+                }
+            }
+        }
+    }
+
     /// Each step of [`newton_bracketed`] leaves the error it promises: from 1e-4 (in units of
     /// g' / m2) off a simple root, Newton's step is within m2 d^2 / (2 |g'|) of the root and
     /// Chebyshev's within (m2^2 / (2 g'^2) + m3 / (6 |g'|)) |d|^3 (d the Newton step; both the
