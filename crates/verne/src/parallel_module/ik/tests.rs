@@ -278,7 +278,6 @@ fn a_stretched_outer_leg_still_reaches() {
             }
         }
     }
-    eprintln!("built (leg II, leg III): {built:?}");
     assert!(built[0] >= 100 && built[1] >= 100, "{built:?}");
 }
 
