@@ -1081,3 +1081,144 @@ fn branches_come_out_by_alpha_then_configuration() {
     }
     assert!(lists > 500, "{lists}");
 }
+
+/// The fast path's test of the rods of leg I crossing (R1 cos(alpha) > r1, in `lower_branch`),
+/// reached: on the default machine the rods' tilt ends a working branch 35 mm before it, so
+/// here machines whose rods cross at a small alpha (R1 - r1 = 3e-5 and 1e-4 mm), the rods
+/// free to tilt to 90 degrees and slider I's stroke starting at 1000 mm. The points put a root
+/// of eq. (9) just past r1/R1 (cos(alpha) = r1/R1 - k 1e-7, inside the margin below r1/R1 that
+/// `working_by_cubic` searches): y from eqs. (11) and (14) (h^2 = k1 - u^2 - y^2 and
+/// h = y (R1 c - r1) / (R1 sin(alpha)), so y^2 (1 + ((R1 c - r1) / (R1 sin(alpha)))^2) =
+/// k1 - u^2), z so that slider I is inside its stroke on the crossing posture alone. There
+/// the branch of the machine's kind fails only as its rods cross, and no branch is working:
+/// the fast path must say so too.
+#[test]
+fn the_fast_path_refuses_a_posture_whose_rods_cross() {
+    use super::working_fast;
+    use crate::parallel_module::branches::{Reason, WORKING_CONFIG};
+    let mut crossing_only = 0;
+    for gap in [3e-5, 1e-4] {
+        let mut m = Machine::default_verne();
+        m.module.r_small1 = m.module.r_big1 - gap;
+        m.limits.rod_tilt_max = std::f64::consts::FRAC_PI_2;
+        m.limits.rho_min[0] = 1000.0;
+        let m = Machine::from_toml_str(&m.to_toml(), "rods crossing at a small alpha")
+            .expect("a valid machine");
+        let g = &m.module;
+        let (r, rr) = (g.r_big1, g.r_small1);
+        let kind = |b: &&IkBranch| b.config == WORKING_CONFIG;
+        for k in 1..10 {
+            let c = rr / r - k as f64 * 1e-7;
+            let (sin_a, delta) = ((1.0 - c * c).sqrt(), r * c - rr);
+            for i in 0..30 {
+                let x = -650.0 + 1100.0 * (i as f64 + 0.5) / 30.0;
+                let u = x + g.dx1;
+                let k1 = g.l1 * g.l1 - r * r - rr * rr + 2.0 * r * rr * c;
+                let y2 = (k1 - u * u) / (1.0 + (delta / (r * sin_a)).powi(2));
+                if y2 <= 0.0 {
+                    continue;
+                }
+                let y = y2.sqrt();
+                // Leg I's postures do not depend on z: place the crossing one's slider I 0.5 mm
+                // (or half the distance to the next posture's) above the stroke's start.
+                let z0 = 1000.0;
+                let at_z0 = solve(&m, &Vector3::new(x, y, z0));
+                let Some(cross) = at_z0
+                    .iter()
+                    .filter(kind)
+                    .find(|b| b.verdict.has(Reason::RodsCross))
+                else {
+                    continue;
+                };
+                let below = at_z0
+                    .iter()
+                    .filter(kind)
+                    .filter(|b| !b.verdict.has(Reason::RodsCross))
+                    .map(|b| cross.rho.x - b.rho.x)
+                    .fold(1.0f64, f64::min);
+                if below <= 0.0 {
+                    continue;
+                }
+                let p = Vector3::new(x, y, m.limits.rho_min[0] + 0.5 * below + (z0 - cross.rho.x));
+                let full = solve(&m, &p);
+                let expected = working(&full);
+                for found in [working_by_cubic(&m, &p), working_fast(&m, &p)] {
+                    assert!(
+                        match (found, expected) {
+                            (None, _) => true,
+                            (Some(f), Some(e)) => same_branch(&f, e),
+                            (Some(_), None) => false,
+                        },
+                        "{gap}: {p:?}: {found:?} vs {expected:?}"
+                    );
+                }
+                let only_crossing = full
+                    .iter()
+                    .filter(kind)
+                    .any(|b| b.verdict.reasons().eq([Reason::RodsCross]));
+                crossing_only += usize::from(only_crossing && expected.is_none());
+            }
+        }
+    }
+    // Points where the crossing posture is the only candidate (27 measured).
+    assert!(crossing_only >= 20, "{crossing_only}");
+}
+
+/// Points whose cubic (9) has a double root exact in double-double, away from alpha = 0: the
+/// postures there are found by the double-double isolation's undecided intervals (each
+/// taken at its midpoint where leg I's equations hold there), which no rounded double root
+/// reaches. With A = U - k0 - 2 R1 r1 c (U = u^2), eq. (9) is
+/// F(c) = (1 - c^2) R1^2 A + Y (R1^2 + r1^2 - 2 R1 r1 c) (Y = y^2); F(c0) = F'(c0) = 0 gives
+/// A = R1 r1 (1 - c0^2) D / ((1 - c0^2) R1 r1 - c0 D), D = R1^2 + r1^2 - 2 R1 r1 c0, and
+/// Y = -c0 R1 A / r1 - R1^2 (1 - c0^2). A search over whole R1, r1 and c0 = k / 2^n found these,
+/// where A is a binary fraction and Y the square of one; L1 and u then solve
+/// L1^2 - u^2 = R1^2 + r1^2 - A - 2 R1 r1 c0 in binary fractions, so that every product in
+/// eq. (9) is exact. There: exactly the posture at alpha = acos(c0) with rho1 from eq. (14) and
+/// its mirror image, to rounding.
+#[test]
+fn postures_at_a_double_root_exact_in_double_double() {
+    use super::leg1_residual_mm;
+    // (R1, r1, L1, u, y, c0), mm.
+    let cases = [
+        (120.0, 80.0, 816.0, -784.0, 210.0, 0.75),
+        (144.0, 64.0, 656.0, -624.0, 162.0, 0.625),
+        (150.0, 72.0, 848.5625, -833.4375, 109.375, 0.75),
+        (135.0, 90.0, 830.0, -790.0, 236.25, 0.75),
+        (135.0, 60.0, 811.25, -788.75, 151.875, 0.625),
+    ];
+    for (r, rr, l1, u, y, c0) in cases {
+        let mut m = Machine::default_verne();
+        (m.module.r_big1, m.module.r_small1, m.module.l1) = (r, rr, l1);
+        let m =
+            Machine::from_toml_str(&m.to_toml(), "an exact double root").expect("a valid machine");
+        for (y, z) in [(y, 1000.0), (-y, 1000.0), (y, 1234.5)] {
+            let p = Vector3::new(u - m.module.dx1, y, z);
+            let c = super::eq9_tracked(&m.module, &p);
+            let at = |x: f64| c.iter().rev().fold(0.0, |acc, t| acc * x + t.v.to_f64());
+            // The root is double in the inputs as given: the coefficients are doubles (34 bits at
+            // most) and F(c0) = F'(c0) = 0 exactly (the third root lies below -1).
+            assert!(c.iter().all(|t| t.v.lo == 0.0), "{c:?}");
+            let d = [
+                c[1].v.to_f64(),
+                2.0 * c[2].v.to_f64(),
+                3.0 * c[3].v.to_f64(),
+            ];
+            assert_eq!((at(c0), d[0] + c0 * (d[1] + c0 * d[2])), (0.0, 0.0));
+            let (legs, certificate) = leg1_postures(&m, &p);
+            let at = format!("R1 {r}, r1 {rr}: {p:?}: {certificate:?} {legs:?}");
+            assert_eq!(certificate, Certificate::Extended, "{at}");
+            assert_eq!(legs.len(), 2, "{at}");
+            let alpha = c0.acos();
+            for l in &legs {
+                // eq. (14): rho1 - zp = y (R1 cos(alpha) - r1) / (R1 sin(alpha)).
+                let rho1 = z + y * (r * c0 - rr) / (r * l.alpha.sin());
+                assert!(
+                    (l.alpha.abs() - alpha).abs() <= 1e-12 && (l.rho1 - rho1).abs() <= 1e-9,
+                    "{at}"
+                );
+                assert!(leg1_residual_mm(&m.module, &p, l) <= 1e-9, "{at}");
+            }
+            assert!(legs[0].alpha * legs[1].alpha < 0.0, "{at}");
+        }
+    }
+}
