@@ -1166,7 +1166,7 @@ fn the_fast_path_refuses_a_posture_whose_rods_cross() {
 
 /// Points whose cubic (9) has a double root exact in double-double, away from alpha = 0: the
 /// postures there are found by the double-double isolation's undecided intervals (each
-/// taken at its midpoint where leg I's equations hold there), which no rounded double root
+/// taken at its midpoint when leg I's equations hold there), which no rounded double root
 /// reaches. With A = U - k0 - 2 R1 r1 c (U = u^2), eq. (9) is
 /// F(c) = (1 - c^2) R1^2 A + Y (R1^2 + r1^2 - 2 R1 r1 c) (Y = y^2); F(c0) = F'(c0) = 0 gives
 /// A = R1 r1 (1 - c0^2) D / ((1 - c0^2) R1 r1 - c0 D), D = R1^2 + r1^2 - 2 R1 r1 c0, and
@@ -1194,7 +1194,7 @@ fn postures_at_a_double_root_exact_in_double_double() {
         for (y, z) in [(y, 1000.0), (-y, 1000.0), (y, 1234.5)] {
             let p = Vector3::new(u - m.module.dx1, y, z);
             let c = super::eq9_tracked(&m.module, &p);
-            let at = |x: f64| c.iter().rev().fold(0.0, |acc, t| acc * x + t.v.to_f64());
+            let f_at = |x: f64| c.iter().rev().fold(0.0, |acc, t| acc * x + t.v.to_f64());
             // The root is double in the inputs as given: the coefficients are doubles (34 bits at
             // most) and F(c0) = F'(c0) = 0 exactly (the third root lies below -1).
             assert!(c.iter().all(|t| t.v.lo == 0.0), "{c:?}");
@@ -1203,7 +1203,7 @@ fn postures_at_a_double_root_exact_in_double_double() {
                 2.0 * c[2].v.to_f64(),
                 3.0 * c[3].v.to_f64(),
             ];
-            assert_eq!((at(c0), d[0] + c0 * (d[1] + c0 * d[2])), (0.0, 0.0));
+            assert_eq!((f_at(c0), d[0] + c0 * (d[1] + c0 * d[2])), (0.0, 0.0));
             let (legs, certificate) = leg1_postures(&m, &p);
             let at = format!("R1 {r}, r1 {rr}: {p:?}: {certificate:?} {legs:?}");
             assert_eq!(certificate, Certificate::Extended, "{at}");
