@@ -1112,9 +1112,9 @@ fn the_fast_path_refuses_a_posture_whose_rods_cross() {
             let (sin_a, delta) = ((1.0 - c * c).sqrt(), r * c - rr);
             for i in 0..30 {
                 let x = -650.0 + 1100.0 * (i as f64 + 0.5) / 30.0;
-                let u = x + g.dx1;
-                let k1 = g.l1 * g.l1 - r * r - rr * rr + 2.0 * r * rr * c;
-                let y2 = (k1 - u * u) / (1.0 + (delta / (r * sin_a)).powi(2));
+                // k1 - u^2: eq. (11)'s h^2 at y = 0.
+                let k1_u2 = super::leg1_height_sq(g, &Vector3::new(x, 0.0, 0.0), c);
+                let y2 = k1_u2 / (1.0 + (delta / (r * sin_a)).powi(2));
                 if y2 <= 0.0 {
                     continue;
                 }
