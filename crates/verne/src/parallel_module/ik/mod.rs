@@ -1202,8 +1202,11 @@ fn working_or_all_into(
     }
 }
 
-/// The machine's branch: the unique feasible one, or (if several are feasible, which the default
-/// machine never shows) the one with the smallest |alpha|.
+/// The machine's branch: the unique feasible one. Two roots of eq. (9) with feasible branches
+/// would both need the leg-I rods within 90 degrees of +z, which makes the cubic increase through each of
+/// them, and two such roots in (r1/R1, 1) force a third (proof and check in
+/// `at_most_one_root_of_eq9_carries_a_feasible_branch`); only the rod-tilt limit's slack leaves a
+/// thin set on a near-parallelogram leg I open, and there the one with the smallest |alpha|.
 pub fn working(branches: &[IkBranch]) -> Option<&IkBranch> {
     branches
         .iter()
