@@ -273,16 +273,13 @@ fn touching_postures(
     let err = eq9_errors(g, p).iter().sum::<f64>() / scale;
     let c = c.map(|a| a / scale);
     for &ct in touching {
-        // Near the critical point ct the cubic is about its second derivative times
-        // (x - ct)^2 / 2: it can come within its error of zero only for |x - ct| below about
-        // sqrt(2 err / |p2|); four times that, plus rounding, is searched.
-        let p2 = (6.0 * c[3] * ct + 2.0 * c[2]).abs();
-        let dc = 4.0 * (2.0 * err / p2.max(f64::MIN_POSITIVE)).sqrt() + 1e-12;
-        let (a_lo, a_hi) = (
-            libm::acos((ct + dc).min(1.0)),
-            libm::acos((ct - dc).max(-1.0)),
-        );
-        match crate::parallel_module::leg1_certify::postures_in(g, p, a_lo, a_hi) {
+        let (c_lo, c_hi) = touching_interval(&c, err, ct);
+        match crate::parallel_module::leg1_certify::postures_in(
+            g,
+            p,
+            libm::acos(c_hi),
+            libm::acos(c_lo),
+        ) {
             Ok(found) => {
                 for (alpha, rho1) in found {
                     let (sin, cos) = alpha.sin_cos();
@@ -298,7 +295,6 @@ fn touching_postures(
             }
             Err(()) => {
                 // Two postures of one sign about to merge: the cubic in double-double.
-                let (c_lo, c_hi) = ((ct - dc).max(-1.0), (ct + dc).min(1.0));
                 match crate::math::certify::poly_roots(&eq9_tracked(g, p), c_lo, c_hi) {
                     Ok(found) if found.decided_up_to_same_root() => {
                         certificate = certificate.max(Certificate::Extended);
@@ -340,6 +336,19 @@ fn touching_postures(
         }
     }
     certificate
+}
+
+/// The interval of cos(alpha) about a critical point `ct` of the cubic (9) `c` (normalised)
+/// where a cubic within `err` of it (the sum of its coefficients' errors, which bounds the error
+/// of its value on [-1, 1]) can have its roots near `ct`, within [-1, 1]. Near `ct` the cubic is
+/// about its second derivative p2 times (x - ct)^2 / 2, so it comes within its error of zero
+/// only for |x - ct| below about sqrt(2 err / |p2|) (sqrt(2) times that where its value at `ct`
+/// is itself up to err off zero); four times that, plus rounding, covers the cubic term too
+/// (`touching_interval_holds_every_root_the_error_allows`: the roots reach 0.37 of it).
+fn touching_interval(c: &[f64; 4], err: f64, ct: f64) -> (f64, f64) {
+    let p2 = (6.0 * c[3] * ct + 2.0 * c[2]).abs();
+    let dc = 4.0 * (2.0 * err / p2.max(f64::MIN_POSITIVE)).sqrt() + 1e-12;
+    ((ct - dc).max(-1.0), (ct + dc).min(1.0))
 }
 
 /// Eqs. (10) and (14) are unchanged by (alpha, z - rho1) -> (-alpha, rho1 - z): the posture at

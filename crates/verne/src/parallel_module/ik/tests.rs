@@ -3,7 +3,8 @@
 //! the steps on leg I, the lanes' start and certificate, the postures at a double root of (9)).
 
 use super::{
-    IkBranch, IkBranches, Leg1, Leg1Equations, solve, working, working_by_cubic, wrap_angle,
+    IkBranch, IkBranches, Leg1, Leg1Equations, solve, touching_interval, working, working_by_cubic,
+    wrap_angle,
 };
 use crate::certificate::Certificate;
 use crate::machine::ik::machine_ik;
@@ -1293,4 +1294,60 @@ fn at_most_one_root_of_eq9_carries_a_feasible_branch() {
     // Measured: 14,820 points, 1,508 pairs with one root's rods up, 3,016 points with a
     // feasible branch.
     assert!(points > 10_000 && one_up > 1000 && one_feasible > 2000);
+}
+
+/// [`touching_interval`] holds every root near the critical point that a cubic within the error
+/// can have. Cubics k (x - ct)^2 (x - d) + v normalised (largest coefficient 1), with the
+/// critical point ct across [-1, 1], the third root d 0.1 to 1.5 away on either side, k from
+/// 1e-3 to 1e3, the error 1e-15 to 1e-6 and the value at ct anywhere within it (the cubic
+/// routine calls ct touching then), each moved by the whole error either way: each root within
+/// (d - ct) / 2 of ct (found by bisection on the factored form, monotone there) lies in the
+/// interval.
+#[test]
+fn touching_interval_holds_every_root_the_error_allows() {
+    let mut roots = 0;
+    for ct in [-0.95, -0.6, -0.2, 0.0, 0.35, 0.7, 0.97] {
+        for delta in [-1.5, -0.5, -0.1, 0.1, 0.5, 1.5] {
+            let d: f64 = ct + delta;
+            for k in [1e-3, 1.0, 1e3] {
+                let raw: [f64; 4] = [
+                    -k * ct * ct * d,
+                    k * (ct * ct + 2.0 * ct * d),
+                    -k * (d + 2.0 * ct),
+                    k,
+                ];
+                let scale = raw.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+                let c = raw.map(|a| a / scale);
+                let kn = k / scale;
+                for err in [1e-15, 1e-12, 1e-9, 1e-6] {
+                    let (lo, hi) = touching_interval(&c, err, ct);
+                    for v in [-err, -0.5 * err, 0.0, 0.5 * err, err] {
+                        for e in [-err, err] {
+                            let f = |t: f64| kn * t * t * (t - delta) + (v + e);
+                            for side in [-1.0, 1.0] {
+                                let (mut a, mut b) = (0.0, side * 0.5 * delta.abs());
+                                if f(a) * f(b) > 0.0 || f(a) == 0.0 {
+                                    continue;
+                                }
+                                for _ in 0..200 {
+                                    let m = 0.5 * (a + b);
+                                    if f(m) * f(a) > 0.0 { a = m } else { b = m }
+                                }
+                                let x = ct + 0.5 * (a + b);
+                                if x.abs() > 1.0 {
+                                    continue;
+                                }
+                                roots += 1;
+                                assert!(
+                                    lo <= x && x <= hi,
+                                    "ct {ct} d {d} k {k} err {err} v {v} e {e}: root {x} outside [{lo}, {hi}]"
+                                );
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert!(roots > 1000, "{roots}");
 }
