@@ -20,6 +20,11 @@ pub const MAX_LENGTH_MM: f64 = 1e30;
 /// (or one written in metres) would be solved to nothing it can resolve.
 pub const MIN_ROD_MM: f64 = 1.0;
 
+/// Two lengths closer than this fraction of the machine's longest rod count as equal where
+/// the kinematics divides by their difference (D1 - d1 and D2 - d2; R1 and r1): 1e-8, 9.5e-6 mm
+/// on the default machine (L3 = 950.46 mm).
+pub const SAME_LENGTH_REL: f64 = 1e-8;
+
 /// How a key's value is read and checked.
 #[derive(Clone, Copy)]
 enum Check {
@@ -324,16 +329,23 @@ impl Machine {
                 );
             }
         }
-        if (m.dx1 - m.dx2).abs() < 1e-6 {
+        // Relative to the machine's size (its longest rod), so that a machine and the same
+        // machine scaled are accepted or refused alike.
+        let same = SAME_LENGTH_REL * m.l1.abs().max(m.l2.abs()).max(m.l3.abs());
+        if (m.dx1 - m.dx2).abs() <= same {
             push(
                 "module.D2",
-                "D2 - d2 must differ from D1 - d1: the forward kinematics eliminates xp between legs I and II".into(),
+                format!(
+                    "D2 - d2 must differ from D1 - d1 by more than {same:e} mm ({SAME_LENGTH_REL:e} of the longest rod): the forward kinematics eliminates xp between legs I and II"
+                ),
             );
         }
-        if (m.r_big1 - m.r_small1).abs() < 1e-6 {
+        if (m.r_big1 - m.r_small1).abs() <= same {
             push(
                 "module.r1",
-                "r1 must differ from R1 (leg I would be a parallelogram and the platform could not rotate)".into(),
+                format!(
+                    "r1 must differ from R1 by more than {same:e} mm ({SAME_LENGTH_REL:e} of the longest rod): leg I would be a parallelogram and the platform could not rotate"
+                ),
             );
         }
         if m.l1 <= (m.r_big1 - m.r_small1).abs() {
@@ -900,5 +912,60 @@ mod tests {
         let text = DEFAULT_MACHINE_TOML.replace("L1 = 850.0", "L1 = 40.0");
         let err = Machine::from_toml_str(&text, "m").unwrap_err();
         assert!(err.to_string().contains("too short"), "{err}");
+    }
+
+    /// The default machine scaled by 1e-2 to 1e4, every length with it: r1 within 1e-12 of R1
+    /// (relative), or D2 - d2 within 1e-12 of D1 - d1, is refused at every scale; 1e-5 apart,
+    /// accepted at every scale (an absolute tolerance of 1e-6 mm accepted the first at 1e4 and
+    /// refused the second at 1e-2).
+    #[test]
+    fn the_same_machine_scaled_is_accepted_or_refused_alike() {
+        let scaled = |k: f64, r1_rel: f64, d2_rel: f64| {
+            let mut m = Machine::default_verne();
+            let g = &mut m.module;
+            for v in [
+                &mut g.dx1,
+                &mut g.dx2,
+                &mut g.r_big1,
+                &mut g.l1,
+                &mut g.r_big2,
+                &mut g.r4,
+                &mut g.l2,
+                &mut g.l3,
+                &mut m.table.d_a,
+                &mut m.table.d_t,
+                &mut m.tool_length,
+            ] {
+                *v *= k;
+            }
+            g.r_small1 = g.r_big1 * (1.0 - r1_rel);
+            g.dx2 = g.dx1 + d2_rel * g.l1.max(g.l2).max(g.l3);
+            for v in m
+                .limits
+                .rho_min
+                .iter_mut()
+                .chain(m.limits.rho_max.iter_mut())
+            {
+                *v *= k;
+            }
+            Machine::from_toml_str(&m.to_toml(), "scaled")
+        };
+        for k in [1e-2, 1.0, 1e2, 1e4] {
+            assert!(
+                scaled(k, 1e-5, 1e-5).is_ok(),
+                "{k}: {:?}",
+                scaled(k, 1e-5, 1e-5)
+            );
+            let err = scaled(k, 1e-12, 1e-5).unwrap_err().to_string();
+            assert!(
+                err.contains("module.r1") && err.contains("r1 must differ from R1"),
+                "{k}: {err}"
+            );
+            let err = scaled(k, 1e-5, 1e-12).unwrap_err().to_string();
+            assert!(
+                err.contains("module.D2") && err.contains("must differ from D1"),
+                "{k}: {err}"
+            );
+        }
     }
 }
