@@ -915,9 +915,10 @@ mod tests {
     }
 
     /// The default machine scaled by 1e-2 to 1e4, every length with it: r1 within 1e-12 of R1
-    /// (relative), or D2 - d2 within 1e-12 of D1 - d1, is refused at every scale; 1e-5 apart,
-    /// accepted at every scale (an absolute tolerance of 1e-6 mm accepted the first at 1e4 and
-    /// refused the second at 1e-2).
+    /// (relative), or D2 - d2 within 1e-12 times the longest rod of D1 - d1, is refused at every
+    /// scale; r1 2e-7 of R1 from it, or D2 - d2 2e-8 of the longest rod from D1 - d1, accepted at
+    /// every scale (an absolute 1e-6 mm accepted the first two at 1e4 and refused the others at
+    /// 1e-2).
     #[test]
     fn the_same_machine_scaled_is_accepted_or_refused_alike() {
         let scaled = |k: f64, r1_rel: f64, d2_rel: f64| {
@@ -952,16 +953,16 @@ mod tests {
         };
         for k in [1e-2, 1.0, 1e2, 1e4] {
             assert!(
-                scaled(k, 1e-5, 1e-5).is_ok(),
+                scaled(k, 2e-7, 2e-8).is_ok(),
                 "{k}: {:?}",
-                scaled(k, 1e-5, 1e-5)
+                scaled(k, 2e-7, 2e-8)
             );
-            let err = scaled(k, 1e-12, 1e-5).unwrap_err().to_string();
+            let err = scaled(k, 1e-12, 2e-8).unwrap_err().to_string();
             assert!(
                 err.contains("module.r1") && err.contains("r1 must differ from R1"),
                 "{k}: {err}"
             );
-            let err = scaled(k, 1e-5, 1e-12).unwrap_err().to_string();
+            let err = scaled(k, 2e-7, 1e-12).unwrap_err().to_string();
             assert!(
                 err.contains("module.D2") && err.contains("must differ from D1"),
                 "{k}: {err}"
