@@ -295,3 +295,54 @@ fn half_angle_poly(f: &PathForms<Tracked>, at_pi: bool) -> Poly8 {
     let second = mul::<5, 5, 9>(&mul::<3, 3, 5>(&yp, &yp), &n);
     add::<9>(&first, &second)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{EQUATION_OPS, Lin, equation_error, path_forms};
+    use crate::selftest::hard_sets::random_geometries;
+    use crate::spec::Machine;
+    use nalgebra::Vector3;
+
+    /// [`equation_error`] bounds the rounding of eq. (15)'s evaluation: it is at least
+    /// [`EQUATION_OPS`] roundings of the formula's magnitude at every theta1 (each linear form
+    /// taken term by term in absolute value there, which is what rounding scales with), and at
+    /// most 16 times that (measured up to 5.3). Tool poses on five machines, points from 1 to
+    /// 1e5 mm, phi1 anywhere, theta1 at 256 angles.
+    #[test]
+    fn equation_error_covers_the_formulas_magnitude() {
+        let mut unit = crate::math::test_rng::lcg(0x1e91_ce27);
+        let mut machines = vec![Machine::default_verne()];
+        machines.extend(random_geometries(4, 15));
+        let abs =
+            |l: &Lin<f64>, s: f64, c: f64| l.c0.abs() + l.cc.abs() * c.abs() + l.cs.abs() * s.abs();
+        let mut loosest = 0.0f64;
+        for m in &machines {
+            let (r, rr) = (m.module.r_big1, m.module.r_small1);
+            for k in 0..2_000 {
+                let span = [1.0, 1e3, 3e3, 1e5][k % 4];
+                let w = Vector3::new(unit() - 0.5, unit() - 0.5, unit() - 0.5) * span;
+                let (sp, cp) = ((unit() - 0.5) * 7.0).sin_cos();
+                let f = path_forms::<f64>(m, &w, sp, cp);
+                let bound = equation_error(m, &w, sp, cp);
+                let largest = (0..256)
+                    .map(|i| {
+                        let (s, c) = (std::f64::consts::TAU * f64::from(i) / 256.0).sin_cos();
+                        let sa = abs(&f.sa, s, c);
+                        let ca = cp.abs() * c.abs() + sp.abs() * s.abs();
+                        let yp = abs(&f.yp, s, c);
+                        r * r * sa * sa * (f.u2 + abs(&f.k1, s, c))
+                            + yp * yp * (r * r + rr * rr + 2.0 * r * rr * ca)
+                    })
+                    .fold(0.0f64, f64::max);
+                let floor = EQUATION_OPS * f64::EPSILON * largest;
+                assert!(
+                    bound >= floor * (1.0 - 1e-12) && bound <= 16.0 * floor,
+                    "{}: w {w:?}, phi1 ({sp}, {cp}): bound {bound:e}, magnitude's rounding {floor:e}",
+                    m.name
+                );
+                loosest = loosest.max(bound / floor);
+            }
+        }
+        assert!(loosest > 1.0, "{loosest}");
+    }
+}
