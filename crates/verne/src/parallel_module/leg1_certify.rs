@@ -345,4 +345,63 @@ mod tests {
         }
         assert!(loosest > 1.0, "{loosest}");
     }
+
+    /// The factors' values and slopes in double precision (for Newton's steps only: the roots are
+    /// proved with the enclosures) are the enclosures' own: at every angle where `value` gives
+    /// them, they lie in `over(x, x)`'s intervals (widened by four times their width and 1e-12
+    /// relative, for the double evaluation's rounding), and where `over` proves leg I cannot
+    /// reach, `value` gives nothing. Points from the five machines' working space and far off,
+    /// both factors, 64 angles each; along tool poses too.
+    #[test]
+    fn factor_values_lie_in_their_enclosures() {
+        use super::{Posture, point_forms};
+        use crate::math::certify::{Enclosure, Factor};
+        use crate::math::interval::Iv;
+        let mut unit = crate::math::test_rng::lcg(0xfac7_0125);
+        let mut machines = vec![Machine::default_verne()];
+        machines.extend(random_geometries(4, 15));
+        let within = |v: f64, iv: Iv| {
+            let slack = 4.0 * (iv.hi - iv.lo) + 1e-12 * iv.lo.abs().max(iv.hi.abs());
+            v >= iv.lo - slack && v <= iv.hi + slack
+        };
+        let (mut checked, mut none) = (0, 0);
+        for m in &machines {
+            for k in 0..400 {
+                let span = [600.0, 1200.0, 1e4][k % 3];
+                let p = Vector3::new(unit() - 0.5, unit() - 0.5, unit()) * span;
+                let (sp, cp) = ((unit() - 0.5) * 7.0).sin_cos();
+                let (fi, ff) = if k % 2 == 0 {
+                    (point_forms(&m.module, &p), point_forms(&m.module, &p))
+                } else {
+                    (path_forms(m, &p, sp, cp), path_forms(m, &p, sp, cp))
+                };
+                for sigma in [1.0, -1.0] {
+                    let f = Posture {
+                        iv: &fi,
+                        f64: &ff,
+                        sigma,
+                    };
+                    for i in 0..64 {
+                        let x = (unit() - 0.5) * 6.5;
+                        match (f.over(x, x), f.value(x)) {
+                            (Enclosure::Values { g, dg }, Some((v, d))) => {
+                                assert!(
+                                    within(v, g) && within(d, dg),
+                                    "{}: {p:?} sigma {sigma} x {x}: ({v}, {d}) against {g:?}, {dg:?}",
+                                    m.name
+                                );
+                                checked += 1;
+                            }
+                            (Enclosure::NoSolution, v) => {
+                                assert!(v.is_none(), "{}: {p:?} x {x} ({i}): {v:?}", m.name);
+                                none += 1;
+                            }
+                            _ => {}
+                        }
+                    }
+                }
+            }
+        }
+        assert!(checked > 50_000 && none > 50_000, "{checked} {none}");
+    }
 }
