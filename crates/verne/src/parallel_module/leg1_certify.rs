@@ -303,6 +303,13 @@ mod tests {
     use crate::spec::Machine;
     use nalgebra::Vector3;
 
+    /// The default machine and four random valid geometries.
+    fn machines() -> Vec<Machine> {
+        let mut out = vec![Machine::default_verne()];
+        out.extend(random_geometries(4, 15));
+        out
+    }
+
     /// [`equation_error`] bounds the rounding of eq. (15)'s evaluation: it is at least
     /// [`EQUATION_OPS`] roundings of the formula's magnitude at every theta1 (each linear form
     /// taken term by term in absolute value there, which is what rounding scales with), and at
@@ -311,8 +318,7 @@ mod tests {
     #[test]
     fn equation_error_covers_the_formulas_magnitude() {
         let mut unit = crate::math::test_rng::lcg(0x1e91_ce27);
-        let mut machines = vec![Machine::default_verne()];
-        machines.extend(random_geometries(4, 15));
+        let machines = machines();
         let abs =
             |l: &Lin<f64>, s: f64, c: f64| l.c0.abs() + l.cc.abs() * c.abs() + l.cs.abs() * s.abs();
         let mut loosest = 0.0f64;
@@ -358,8 +364,7 @@ mod tests {
         use crate::math::certify::{Enclosure, Factor};
         use crate::math::interval::Iv;
         let mut unit = crate::math::test_rng::lcg(0xfac7_0125);
-        let mut machines = vec![Machine::default_verne()];
-        machines.extend(random_geometries(4, 15));
+        let machines = machines();
         let within = |v: f64, iv: Iv| {
             let slack = 4.0 * (iv.hi - iv.lo) + 1e-12 * iv.lo.abs().max(iv.hi.abs());
             v >= iv.lo - slack && v <= iv.hi + slack

@@ -812,13 +812,21 @@ fn point_from_u_and_y(m: &Machine, c0: f64, u2: f64, y2: f64) -> Option<Vector3<
         .then(|| Vector3::new(u2.sqrt() - g.dx1, y2.sqrt(), 1000.0))
 }
 
+/// (U, Y) where two of [`eq9_in_u_and_y`]'s linear functions a[0] + U a[1] + Y a[2] and
+/// b[0] + U b[1] + Y b[2] are both zero (Cramer's rule).
+fn u_and_y_where(a: [f64; 3], b: [f64; 3]) -> (f64, f64) {
+    let det = a[1] * b[2] - a[2] * b[1];
+    (
+        (a[2] * b[0] - a[0] * b[2]) / det,
+        (a[0] * b[1] - a[1] * b[0]) / det,
+    )
+}
+
 /// A point whose cubic (9) has a double root at cos(alpha) = c0 (F(c0) = F'(c0) = 0, linear
 /// in u^2 and y^2) and whose leg I reaches there.
 fn on_double_root(m: &Machine, c0: f64) -> Option<Vector3<f64>> {
     let (f, d) = eq9_in_u_and_y(m, c0);
-    let det = f[1] * d[2] - f[2] * d[1];
-    let u2 = (f[2] * d[0] - f[0] * d[2]) / det;
-    let y2 = (f[0] * d[1] - f[1] * d[0]) / det;
+    let (u2, y2) = u_and_y_where(f, d);
     point_from_u_and_y(m, c0, u2, y2)
 }
 
@@ -1256,9 +1264,7 @@ fn at_most_one_root_of_eq9_carries_a_feasible_branch() {
         let at = |i: usize| rr / r + (1.0 - rr / r) * i as f64 / n as f64;
         for (ca, cb) in (1..n).flat_map(|i| (i + 1..n).map(move |j| (at(i), at(j)))) {
             let ((fa, _), (fb, _)) = (eq9_in_u_and_y(&m, ca), eq9_in_u_and_y(&m, cb));
-            let det = fa[1] * fb[2] - fa[2] * fb[1];
-            let u2 = (fa[2] * fb[0] - fa[0] * fb[2]) / det;
-            let y2 = (fa[0] * fb[1] - fa[1] * fb[0]) / det;
+            let (u2, y2) = u_and_y_where(fa, fb);
             let (Some(p), Some(_)) = (
                 point_from_u_and_y(&m, ca, u2, y2),
                 point_from_u_and_y(&m, cb, u2, y2),
