@@ -25,6 +25,7 @@ use crate::math::dd::Tracked;
 use crate::math::interval::Iv;
 use crate::math::scalar::{Mag, Scalar};
 use crate::spec::{Machine, ModuleGeometry};
+use crate::tolerance::SQRT_ARG_REL;
 
 /// The linear forms in theta1 of the equation along one tool pose, in any arithmetic.
 #[derive(Debug, Clone, Copy)]
@@ -39,6 +40,8 @@ pub(crate) struct PathForms<T> {
     /// u^2 = (xp + D1 - d1)^2 (constant along the pose).
     u2: T,
     r: T,
+    /// L1^2, the scale of leg I's radicand K1 - u^2 - yp^2.
+    l1_sq: T,
 }
 
 /// The forms from the tilt-frame platform point `w` and (sin, cos) of phi1, taken as exact.
@@ -63,6 +66,7 @@ pub(crate) fn path_forms<T: Scalar>(
         k1: Lin::new(t(g.l1) * t(g.l1) - r * r - rr * rr, rr2 * cp, -(rr2 * sp)),
         u2: u * u,
         r,
+        l1_sq: t(g.l1) * t(g.l1),
     }
 }
 
@@ -81,6 +85,7 @@ pub(crate) fn point_forms<T: Scalar>(g: &ModuleGeometry, p: &Vector3<f64>) -> Pa
         k1: Lin::new(t(g.l1) * t(g.l1) - r * r - rr * rr, rr2, zero),
         u2: u * u,
         r,
+        l1_sq: t(g.l1) * t(g.l1),
     }
 }
 
@@ -185,16 +190,23 @@ impl Factor for Posture<'_> {
     }
 }
 
+/// Leg I's radicand rad = K1 - u^2 - yp^2 = (rho1 - zp)^2 at (sin, cos) of the angle; zero
+/// where it is negative by less than [`SQRT_ARG_REL`] L1^2 (rounding at a stretched leg I, as
+/// for eqs. (11)-(13)); None below, where leg I cannot reach.
+fn leg1_radicand(f: &PathForms<f64>, s: f64, c: f64) -> Option<f64> {
+    let yp = f.yp.at(s, c);
+    let rad = f.k1.at(s, c) - f.u2 - yp * yp;
+    (rad >= -SQRT_ARG_REL * f.l1_sq).then_some(rad.max(0.0))
+}
+
 /// rho1 of the leg-I posture at a root theta1 = x of F: zp - sigma sqrt(rad) for the factor
-/// h_sigma the root belongs to (the smaller |h| there); None where leg I cannot reach.
+/// h_sigma the root belongs to (the smaller |h| there); None where leg I cannot reach. A root of
+/// F where leg I cannot reach is the one F has wherever sin(alpha) = yp = 0 (F = yp^2 N + R1^2
+/// sin^2(alpha) (u^2 - K1), module documentation): no posture.
 pub(crate) fn posture_rho1(f: &PathForms<f64>, x: f64) -> Option<f64> {
     let (s, c) = x.sin_cos();
     let yp = f.yp.at(s, c);
-    let rad = f.k1.at(s, c) - f.u2 - yp * yp;
-    if rad < 0.0 {
-        return None;
-    }
-    let q = rad.sqrt();
+    let q = leg1_radicand(f, s, c)?.sqrt();
     let h = |sigma: f64| (yp * f.wf.at(s, c) + sigma * f.r * f.sa.at(s, c) * q).abs();
     let sigma = if h(1.0) <= h(-1.0) { 1.0 } else { -1.0 };
     Some(f.zp.at(s, c) - sigma * q)
@@ -202,10 +214,9 @@ pub(crate) fn posture_rho1(f: &PathForms<f64>, x: f64) -> Option<f64> {
 
 /// The postures of both signs of rho1 - zp at the angle x (where leg I reaches).
 fn both_signs(f: &PathForms<f64>, x: f64, to: &mut ArrayVec<Proved, 12>) {
-    for sigma in [1.0, -1.0] {
-        let (s, c) = x.sin_cos();
-        let yp = f.yp.at(s, c);
-        if f.k1.at(s, c) - f.u2 - yp * yp >= 0.0 {
+    let (s, c) = x.sin_cos();
+    if leg1_radicand(f, s, c).is_some() {
+        for sigma in [1.0, -1.0] {
             let _ = to.try_push((x, factor_rho1(f, x, sigma)));
         }
     }
@@ -408,5 +419,230 @@ mod tests {
             }
         }
         assert!(checked > 50_000 && none > 50_000, "{checked} {none}");
+    }
+
+    /// The half-angle polynomial of the double-double path is (1 + t^2)^4 F: in each chart (t =
+    /// tan(x / 2) about 0, tan((x - pi) / 2) about pi), its value at 32 angles of the chart
+    /// agrees with F(x) (1 + t^2)^4, F = R1^2 sa^2 (u^2 - K1) + yp^2 N computed from the
+    /// trigonometric forms, to 1e-12 of the terms' magnitudes. Tool poses on five machines.
+    #[test]
+    fn half_angle_polynomial_is_the_equation_times_its_denominator() {
+        use super::half_angle_poly;
+        use crate::math::dd::Tracked;
+        let mut unit = crate::math::test_rng::lcg(0x4a1f_a261);
+        let mut checked = 0;
+        for m in &machines() {
+            for k in 0..200 {
+                let span = [1.0, 1e3, 3e3][k % 3];
+                let w = Vector3::new(unit() - 0.5, unit() - 0.5, unit() - 0.5) * span;
+                let (sp, cp) = ((unit() - 0.5) * 7.0).sin_cos();
+                let f = path_forms::<f64>(m, &w, sp, cp);
+                let tf = path_forms::<Tracked>(m, &w, sp, cp);
+                for (at_pi, centre) in [(false, 0.0), (true, std::f64::consts::PI)] {
+                    let coefficients = half_angle_poly(&tf, at_pi).map(|c| c.v.to_f64());
+                    for _ in 0..32 {
+                        let x = centre + (unit() - 0.5) * std::f64::consts::PI;
+                        let t = (0.5 * (x - centre)).tan();
+                        let (value, size) = coefficients
+                            .iter()
+                            .rev()
+                            .fold((0.0, 0.0), |(v, a), c| (v * t + c, a * t.abs() + c.abs()));
+                        let (s, c) = x.sin_cos();
+                        let (sa, yp, k1, wf) =
+                            (f.sa.at(s, c), f.yp.at(s, c), f.k1.at(s, c), f.wf.at(s, c));
+                        let r2sa2 = f.r * f.r * sa * sa;
+                        let big_f = r2sa2 * (f.u2 - k1) + yp * yp * (wf * wf + r2sa2);
+                        let terms = r2sa2 * (f.u2 + k1.abs()) + yp * yp * (wf * wf + r2sa2);
+                        let scale = (1.0 + t * t).powi(4);
+                        assert!(
+                            (value - big_f * scale).abs() <= 1e-12 * (size + terms * scale),
+                            "{}: w {w:?} x {x} ({at_pi}): {value:e} against {:e}",
+                            m.name,
+                            big_f * scale
+                        );
+                        checked += 1;
+                    }
+                }
+            }
+        }
+        assert_eq!(checked, 64_000);
+    }
+
+    /// A leg-I posture built to be true along a tool pose: alpha, sigma and q = |rho1 - zp|
+    /// chosen, yp from h_sigma = 0 (module documentation), u from rad = q^2, zp free; then phi1
+    /// and the tilt-frame point w of theta1 = alpha - phi1 (AIM 2007 eqs. (7)-(9)).
+    struct Built {
+        w: Vector3<f64>,
+        phi1: (f64, f64),
+        theta1: f64,
+        rho1: f64,
+        /// rho1 of the other sign: zp + sigma q.
+        mirror: f64,
+    }
+
+    /// A posture of [`Built`] with q = `q_frac` L1, alpha clear of sin(alpha) = 0 and of
+    /// R1 cos(alpha) = r1 (where yp would be unbounded).
+    fn built(m: &Machine, q_frac: f64, unit: &mut impl FnMut() -> f64) -> Built {
+        let g = &m.module;
+        let (r, rr) = (g.r_big1, g.r_small1);
+        loop {
+            let alpha = (unit() - 0.5) * 6.0;
+            let (sa, ca) = alpha.sin_cos();
+            let wf = r * ca - rr;
+            if sa.abs() < 0.05 || wf.abs() < 0.05 * r {
+                continue;
+            }
+            let sigma = if unit() < 0.5 { 1.0 } else { -1.0 };
+            let q = q_frac * g.l1;
+            let yp = -sigma * r * sa * q / wf;
+            let k1 = g.l1 * g.l1 - r * r - rr * rr + 2.0 * r * rr * ca;
+            let u2 = k1 - yp * yp - q * q;
+            if u2 <= 0.0 {
+                continue;
+            }
+            let u = if unit() < 0.5 { u2.sqrt() } else { -u2.sqrt() };
+            let zp = (unit() - 0.5) * 2.0 * g.l1;
+            let p = Vector3::new(u - g.dx1, yp, zp);
+            let phi1 = (unit() - 0.5) * 6.0;
+            let theta1 = alpha - phi1;
+            let (s, c) = theta1.sin_cos();
+            let dz = p.z - m.table.d_a;
+            return Built {
+                w: Vector3::new(p.x, c * p.y + s * dz, -s * p.y + c * dz),
+                phi1: phi1.sin_cos(),
+                theta1,
+                rho1: zp - sigma * q,
+                mirror: zp + sigma * q,
+            };
+        }
+    }
+
+    /// `posture_rho1` and `both_signs` at a built posture: the one chooses its factor's sign, the
+    /// other gives both signs, and nothing where leg I cannot reach (the point moved out by 4 L1).
+    #[test]
+    fn postures_at_a_built_root_have_their_rho1() {
+        use super::{both_signs, posture_rho1};
+        let mut unit = crate::math::test_rng::lcg(0x0b17_5e75);
+        let mut checked = 0;
+        for m in &machines() {
+            for k in 0..400 {
+                let b = built(m, [0.05, 0.2, 0.5][k % 3], &mut unit);
+                let f = path_forms::<f64>(m, &b.w, b.phi1.0, b.phi1.1);
+                let tol = 1e-9 * m.module.l1;
+                let rho1 = posture_rho1(&f, b.theta1).expect("leg I reaches");
+                assert!(
+                    (rho1 - b.rho1).abs() < tol,
+                    "{}: {rho1} vs {}",
+                    m.name,
+                    b.rho1
+                );
+                let mut both = arrayvec::ArrayVec::new();
+                both_signs(&f, b.theta1, &mut both);
+                assert_eq!(both.len(), 2, "{}", m.name);
+                // sigma = 1 first: zp - q, then zp + q.
+                for (x, want) in both
+                    .iter()
+                    .zip([b.rho1.min(b.mirror), b.rho1.max(b.mirror)])
+                {
+                    assert!(x.0 == b.theta1 && (x.1 - want).abs() < tol, "{both:?}");
+                }
+                let far = Vector3::new(b.w.x + 4.0 * m.module.l1, b.w.y, b.w.z);
+                let f = path_forms::<f64>(m, &far, b.phi1.0, b.phi1.1);
+                assert_eq!(posture_rho1(&f, b.theta1), None);
+                both.clear();
+                both_signs(&f, b.theta1, &mut both);
+                assert!(both.is_empty());
+                checked += 1;
+            }
+        }
+        assert_eq!(checked, 2_000);
+    }
+
+    /// `resolve` on an interval of 2e-6 rad about a built posture: the posture is proved (or
+    /// allowed), never lost, with leg I from far (q = L1 / 1e3) to fully stretched (q = 0), where
+    /// the factors' derivatives are unbounded and double-double decides. There leg I's radicand
+    /// is zero to rounding and may come out negative: still a posture, rho1 = zp. The tolerance on
+    /// rho1 is sqrt(64 eps) L1, the square root of the radicand's rounding.
+    #[test]
+    fn resolve_proves_every_built_posture() {
+        use super::{Resolution, resolve};
+        let mut unit = crate::math::test_rng::lcg(0x02e5_017e);
+        let mut by_dd = 0;
+        for m in &machines() {
+            let tol = (64.0 * f64::EPSILON).sqrt() * m.module.l1;
+            for k in 0..120 {
+                let q = [1e-3, 1e-5, 1e-7, 1e-9, 1e-11, 0.0][k % 6];
+                let b = built(m, q, &mut unit);
+                let mut proved = arrayvec::ArrayVec::new();
+                let mut allowed = arrayvec::ArrayVec::new();
+                let mut fallback = arrayvec::ArrayVec::new();
+                let how = resolve(
+                    m,
+                    &b.w,
+                    b.phi1,
+                    &[[b.theta1 - 1e-6, b.theta1 + 1e-6]],
+                    &mut proved,
+                    &mut allowed,
+                    &mut fallback,
+                );
+                let found = proved
+                    .iter()
+                    .chain(&allowed)
+                    .any(|&(x, rho1)| (x - b.theta1).abs() < 1e-9 && (rho1 - b.rho1).abs() < tol);
+                assert!(
+                    how != Resolution::Unproved && fallback.is_empty() && found,
+                    "{} q {q}: {how:?}, theta1 {} rho1 {}: proved {proved:?} allowed {allowed:?}",
+                    m.name,
+                    b.theta1,
+                    b.rho1
+                );
+                by_dd += usize::from(how == Resolution::Extended);
+            }
+        }
+        assert!(by_dd >= 200, "{by_dd}");
+    }
+
+    /// The machine's inverse kinematics where leg I is fully stretched on Table II's set (alpha
+    /// = 0, yp = 0, rho1 = zp): F has a double root there, which only double-double decides,
+    /// and the radicand is zero to rounding. Every branch is found and proved (331 of 1,000 were
+    /// unproved when a radicand negative by rounding meant "leg I cannot reach"). |zp| >= 100 mm:
+    /// nearer zp = 0 the polish of the seeds at sin(alpha) = 0 ends a few 1e-6 mm from the proved
+    /// posture along the fold, farther than `SAME_SOLUTION_MM` (1 + |rho1|), and the duplicate
+    /// makes the result unproved (16 of 1,000 with zp anywhere; docs/reliability.md).
+    #[test]
+    fn machine_ik_at_a_stretched_leg1_on_table_ii_is_proved() {
+        use crate::machine::{machine_ik, tool_pose_eq26};
+        use crate::parallel_module::equations::ModulePose;
+        use crate::parallel_module::ik::{solve, wrap_angle};
+        let mut unit = crate::math::test_rng::lcg(0x7ab1e2);
+        let (mut poses, mut unproved) = (0, 0);
+        for m in &machines() {
+            let g = &m.module;
+            // u^2 = K1 at alpha = 0: rad = K1 - u^2 - yp^2 = 0.
+            let u = (g.l1 * g.l1 - (g.r_big1 - g.r_small1).powi(2)).sqrt();
+            for k in 0..400 {
+                let x = if k % 2 == 0 { u } else { -u } - g.dx1;
+                let zp = (100.0 + unit() * (g.l1 - 100.0)) * if k % 4 < 2 { 1.0 } else { -1.0 };
+                let p = Vector3::new(x, 0.0, zp);
+                let theta1 = (unit() - 0.5) * 2.0;
+                // Legs II and III reach only some of these points.
+                let Some(b) = solve(m, &p).into_iter().find(|b| b.alpha.abs() < 1e-6) else {
+                    continue;
+                };
+                let module = ModulePose { p, alpha: 0.0 };
+                let tool = tool_pose_eq26(&m.table, &module, theta1, 0.3, m.tool_length);
+                let ik = machine_ik(m, &tool, m.tool_length);
+                assert!(
+                    ik.iter().any(|x| (x.rho - b.rho).amax() < 1e-3
+                        && wrap_angle(x.theta1 - theta1).abs() < 1e-6),
+                    "{}: {p:?}, theta1 {theta1}: lacks rho {:?}",
+                    m.name,
+                    b.rho
+                );
+                poses += 1;
+                unproved += usize::from(!ik.certificate.proved());
+            }
+        }
+        assert!(poses >= 500 && unproved == 0, "{poses} {unproved}");
     }
 }
