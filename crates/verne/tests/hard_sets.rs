@@ -115,3 +115,84 @@ fn the_reported_triples_give_every_mode() {
         assert!(modes.certificate.proved());
     }
 }
+
+/// Where condition (21) (Det = 0), b = 0 and a tangent of leg I (Delta = 0: the two tau of
+/// eq. (10) on the line of eq. (14) are equal) meet at one alpha, two assembly modes merge at a
+/// zero of Det, and both factors of F lose their square root's smoothness. Four slider
+/// triples of the default machine do this (rho1 = 0; found by `mpmath.findroot` on Det = b =
+/// Delta = 0 at 40 digits, checked here to vanish to 1e-9 of their scales), shifted along rho2
+/// by d from -1e-6 to 1e-6 mm and along all three sliders by 0, 300 and 1,700 mm. At 50 digits
+/// (the minimum of F next to alpha) each shift of 1e-10 mm or more has two modes on one side
+/// and none on the other; the solver must agree, and within 1e-12 mm give at most two, every
+/// answer proved and every mode within 1e-9 mm of closing.
+#[test]
+fn where_condition_21_meets_a_tangent_of_leg_i_both_modes_are_found() {
+    use verne::parallel_module::equations::residual_mm;
+    use verne::parallel_module::ik::wrap_angle;
+    let m = Machine::default_verne();
+    let g = &m.module;
+    let (r, rr, r2, r4) = (g.r_big1, g.r_small1, g.r_big2, g.r4);
+    let delta = g.dx2 - g.dx1;
+    let k0 = g.l1 * g.l1 - r * r - rr * rr;
+    for (p2, p3, alpha) in [
+        (
+            -1627.7550604132189,
+            -1627.8666764352438,
+            -4.787157408607968e-5,
+        ),
+        (1283.040403527657, 1283.1107411285327, -3.141465950265598),
+        (1627.7550604132189, 1627.8666764352438, 4.787157408607968e-5),
+        (-1283.040403527657, -1283.1107411285327, -3.1417193569139883),
+    ] {
+        // The forms of the elimination (fk_certify's module documentation) at alpha.
+        let (s, c) = f64::sin_cos(alpha);
+        let b = g.l3 * g.l3 - g.l2 * g.l2 + (p2 + p3) * (p2 - p3) + 2.0 * r2 * (p2 + p3) * s;
+        let det = 2.0 * (p2 - p3) * (r * c - rr) + 4.0 * (r * r4 - rr * r2) * s;
+        let a = g.l2 * g.l2 - k0 - delta * delta - r2 * r2 - r4 * r4 - p2 * p2
+            + 2.0 * (r2 * r4 - r * rr) * c
+            - 2.0 * r2 * p2 * s;
+        let q = (r * c - rr) * p2 + (r * r4 - rr * r2) * s;
+        let n = r * r + rr * rr - 2.0 * r * rr * c;
+        let k1 = k0 + 2.0 * r * rr * c;
+        let p4 = q * q + delta * delta * n;
+        let disc = 4.0 * k1 * p4 - n * a * a;
+        assert!(
+            det.abs() < 1e-9 * 4.0 * (r * r4 - rr * r2).abs(),
+            "Det {det}"
+        );
+        assert!(b.abs() < 1e-9 * (p2 * p2 + g.l2 * g.l2), "b {b}");
+        assert!(
+            disc.abs() < 1e-9 * (4.0 * k1.abs() * p4 + n * a * a),
+            "Delta {disc}"
+        );
+        for rho1 in [0.0, 300.0, 1700.0] {
+            let near = |d: f64| {
+                let rho = nalgebra::Vector3::new(rho1, rho1 + p2 + d, rho1 + p3);
+                let modes = fk::solve(&m, &rho);
+                assert!(
+                    modes.certificate.proved(),
+                    "{rho:?}: {:?}",
+                    modes.certificate
+                );
+                let near: Vec<_> = modes
+                    .iter()
+                    .filter(|x| wrap_angle(x.pose.alpha - alpha).abs() < 1e-3)
+                    .collect();
+                for x in &near {
+                    assert!(residual_mm(g, &x.pose, &rho) < 1e-9, "{rho:?}: {x:?}");
+                }
+                near.len()
+            };
+            for d in [1e-10, 1e-8, 1e-6] {
+                let (up, down) = (near(d), near(-d));
+                assert!(
+                    up + down == 2 && up * down == 0,
+                    "{p2} {rho1} {d}: {up} {down}"
+                );
+            }
+            for d in [0.0, 1e-12, -1e-12] {
+                assert!(near(d) <= 2, "{p2} {rho1} {d}");
+            }
+        }
+    }
+}
