@@ -291,4 +291,151 @@ mod tests {
         assert!(diff <= e.error(3), "{diff} {}", e.error(3));
         assert_eq!(e.mag, (x + y) * (x + y));
     }
+
+    /// Exact rationals for the checks below (num-rational: every double is a rational).
+    type Exact = num_rational::BigRational;
+
+    fn exact(x: f64) -> Exact {
+        Exact::from_float(x).expect("finite")
+    }
+
+    fn exact_dd(x: Dd) -> Exact {
+        exact(x.hi) + exact(x.lo)
+    }
+
+    fn abs_exact(x: Exact) -> Exact {
+        if x < exact(0.0) { -x } else { x }
+    }
+
+    /// Random double-doubles over 2^-60 to 2^60, both signs, normalised (the sum of two doubles
+    /// of which the second is up to 2^-40 of the first, or an exact sum of two unrelated ones).
+    fn random_dd(unit: &mut impl FnMut() -> f64, k: usize) -> Dd {
+        let scale = 2f64.powi((unit() * 120.0) as i32 - 60);
+        let a = (unit() - 0.5) * scale;
+        let b = (unit() - 0.5) * scale * if k % 2 == 0 { 2f64.powi(-40) } else { 1.0 };
+        Dd::sum(a, b)
+    }
+
+    /// |lo| is at most half a unit of hi: hi is the double nearest hi + lo.
+    fn normalised(x: Dd) -> bool {
+        x.hi + x.lo == x.hi
+    }
+
+    /// Every operation of [`Dd`] against exact rational arithmetic on 20,000 pairs: the results
+    /// are normalised and within [`DD_OP_ERROR`] of the operands' magnitudes (sum: |a| + |b|,
+    /// product: |a| |b|); `prod` and `sum` of two doubles are exact, and so are negation and
+    /// `abs`. The signs and `to_f64` (the nearest double) follow the exact value.
+    #[test]
+    fn every_operation_is_within_its_bound_of_the_exact_result() {
+        let mut unit = crate::math::test_rng::lcg(0x000d_d0b5);
+        let bound = |mag: Exact| mag * exact(DD_OP_ERROR);
+        for k in 0..20_000 {
+            let (a, b) = (random_dd(&mut unit, k), random_dd(&mut unit, k / 2));
+            let (ea, eb) = (exact_dd(a), exact_dd(b));
+            let mag_sum = abs_exact(ea.clone()) + abs_exact(eb.clone());
+            let mag_prod = abs_exact(ea.clone()) * abs_exact(eb.clone());
+            for (name, got, want, mag) in [
+                ("+", a + b, ea.clone() + eb.clone(), mag_sum.clone()),
+                ("-", a - b, ea.clone() - eb.clone(), mag_sum),
+                ("*", a * b, ea.clone() * eb.clone(), mag_prod.clone()),
+                (
+                    "* f64",
+                    a * b.hi,
+                    ea.clone() * exact(b.hi),
+                    abs_exact(ea.clone() * exact(b.hi)),
+                ),
+            ] {
+                assert!(normalised(got), "{a:?} {name} {b:?}: {got:?}");
+                let err = abs_exact(exact_dd(got) - want);
+                assert!(err <= bound(mag), "{a:?} {name} {b:?}: {got:?}");
+            }
+            assert_eq!(exact_dd(Dd::prod(a.hi, b.hi)), exact(a.hi) * exact(b.hi));
+            assert_eq!(exact_dd(Dd::sum(a.hi, b.lo)), exact(a.hi) + exact(b.lo));
+            assert!(normalised(Dd::sum(a.hi, b.lo)) && normalised(Dd::prod(a.hi, b.hi)));
+            assert_eq!(exact_dd(-a), -ea.clone());
+            assert_eq!(exact_dd(a.abs()), abs_exact(ea.clone()));
+            let sign = if ea > exact(0.0) { 1.0 } else { -1.0 };
+            assert_eq!(a.signum(), sign);
+            // to_f64 is hi + lo rounded: the nearest double to the exact value.
+            let x = a.to_f64();
+            let gap = abs_exact(exact(x) - ea.clone());
+            for y in [
+                super::super::interval::next_up(x),
+                super::super::interval::next_down(x),
+            ] {
+                assert!(gap <= abs_exact(exact(y) - ea.clone()), "{a:?}");
+            }
+        }
+        assert_eq!(Dd::ZERO.signum(), 0.0);
+        assert_eq!(
+            Dd {
+                hi: 0.0,
+                lo: -1e-300
+            }
+            .signum(),
+            -1.0
+        );
+        assert_eq!(
+            Dd {
+                hi: 0.0,
+                lo: 1e-300
+            }
+            .signum(),
+            1.0
+        );
+        assert!(
+            Dd::ZERO.is_finite()
+                && !Dd {
+                    hi: 1.0,
+                    lo: f64::NAN
+                }
+                .is_finite()
+        );
+        assert!(
+            !Dd {
+                hi: f64::INFINITY,
+                lo: 0.0
+            }
+            .is_finite()
+        );
+    }
+
+    /// [`Tracked`] on random expressions of exact inputs (sums, differences, products, negations
+    /// and scalings, up to 12 operations deep): the value is within `error(ops)` of the exact
+    /// one, where ops is the expression's depth, and `mag` is the value of the same expression
+    /// on the inputs' absolute values with every difference a sum (to 1e-12).
+    #[test]
+    fn tracked_bounds_hold_on_random_expressions() {
+        let mut unit = crate::math::test_rng::lcg(0x0007_aced);
+        for _ in 0..2_000 {
+            let input = |u: &mut dyn FnMut() -> f64| {
+                let x = (u() - 0.5) * 2f64.powi((u() * 40.0) as i32 - 20);
+                (Tracked::exact(x), exact(x), exact(x.abs()))
+            };
+            let (mut t, mut e, mut m) = input(&mut unit);
+            for depth in 1..=12u32 {
+                let (u, eu, mu) = input(&mut unit);
+                (t, e, m) = match (unit() * 5.0) as u32 {
+                    0 => (t + u, e + eu, m + mu),
+                    1 => (t - u, e - eu, m + mu),
+                    2 => (u - t, eu - e, m + mu),
+                    3 => (t * u, e * eu, m * mu),
+                    _ => {
+                        let k = (unit() - 0.5) * 8.0;
+                        (-(t * k), -(e * exact(k)), m * exact(k.abs()))
+                    }
+                };
+                let err = abs_exact(exact_dd(t.v) - e.clone());
+                assert!(err <= exact(t.error(depth)), "depth {depth}: {t:?}");
+                let rel = abs_exact(exact(t.mag) - m.clone());
+                assert!(rel <= m.clone() * exact(1e-12), "depth {depth}: {t:?}");
+            }
+        }
+        assert_eq!(
+            Tracked::exact(-2.0).error(3),
+            3.0 * DD_OP_ERROR * 2.0 * (1.0 + 1e-12)
+        );
+        assert_eq!(Tracked::from(-2.5), Tracked::exact(-2.5));
+        assert_eq!(Tracked::exact(-2.5).mag, 2.5);
+    }
 }
