@@ -262,6 +262,38 @@ mod tests {
         assert_eq!(next_up(0.0), f64::from_bits(1));
         assert_eq!(next_down(0.0), -f64::from_bits(1));
         assert_eq!(next_up(f64::MAX), f64::INFINITY);
+        assert_eq!(next_up(f64::INFINITY), f64::INFINITY);
+        assert_eq!(next_down(f64::NEG_INFINITY), f64::NEG_INFINITY);
+        assert_eq!(next_up(f64::NEG_INFINITY), -f64::MAX);
+        assert!(next_up(f64::NAN).is_nan() && next_down(f64::NAN).is_nan());
+    }
+
+    /// The predicates the proofs rest on at their edges: an interval touching zero has no
+    /// sign, one with an infinite or NaN end is not finite.
+    #[test]
+    fn signs_and_finiteness_at_the_edges() {
+        for (iv, sign) in [
+            (Iv::new(0.0, 1.0), None),
+            (Iv::new(-1.0, 0.0), None),
+            (Iv::point(0.0), None),
+            (Iv::new(-1.0, 1.0), None),
+            (Iv::new(f64::MIN_POSITIVE, 1.0), Some(1)),
+            (Iv::new(-1.0, -f64::MIN_POSITIVE), Some(-1)),
+        ] {
+            assert_eq!(iv.sign(), sign, "{iv:?}");
+            assert_eq!(iv.positive(), sign == Some(1), "{iv:?}");
+            assert_eq!(iv.negative(), sign == Some(-1), "{iv:?}");
+        }
+        assert!(Iv::new(-1.0, 2.0).is_finite());
+        for iv in [
+            Iv::new(f64::NEG_INFINITY, 0.0),
+            Iv::new(0.0, f64::INFINITY),
+            Iv::new(f64::NAN, 0.0),
+            Iv::new(0.0, f64::NAN),
+            Iv::ENTIRE,
+        ] {
+            assert!(!iv.is_finite(), "{iv:?}");
+        }
     }
 
     /// Every operation's interval holds the exact result of sample points, checked against

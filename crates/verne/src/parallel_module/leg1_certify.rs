@@ -604,7 +604,7 @@ mod tests {
 
     /// The machine's inverse kinematics where leg I is fully stretched on Table II's set (alpha
     /// = 0, yp = 0, rho1 = zp): F has a double root there, which only double-double decides,
-    /// and the radicand is zero to rounding. Every branch is found and proved (331 of 1,000 were
+    /// and the radicand is zero to rounding. Every branch is found and proved (333 of 1,000 were
     /// unproved when a radicand negative by rounding meant "leg I cannot reach"). |zp| >= 100 mm:
     /// nearer zp = 0 the polish of the seeds at sin(alpha) = 0 ends a few 1e-6 mm from the proved
     /// posture along the fold, farther than `SAME_SOLUTION_MM` (1 + |rho1|), and the duplicate
