@@ -285,6 +285,16 @@ mod tests {
             assert_eq!(iv.negative(), sign == Some(-1), "{iv:?}");
         }
         assert!(Iv::new(-1.0, 2.0).is_finite());
+        // The midpoint; x^(1/2) of an interval touching zero from below, and of one below it.
+        assert_eq!(Iv::new(1.0, 4.0).mid(), 2.5);
+        assert_eq!(Iv::new(-3.0, -2.0).mid(), -2.5);
+        assert_eq!(Iv::new(-1.0, 0.0).sqrt(), Iv::new(0.0, next_up(0.0)));
+        assert!(Iv::new(-2.0, -1.0).sqrt().lo.is_nan());
+        // 0 times an unbounded interval: exactly 0 for a zero-width zero, unbounded otherwise.
+        assert_eq!(Iv::point(0.0) * Iv::ENTIRE, Iv::point(0.0));
+        assert_eq!(Iv::ENTIRE * Iv::point(0.0), Iv::point(0.0));
+        assert_eq!(Iv::new(0.0, 1.0) * Iv::ENTIRE, Iv::ENTIRE);
+        assert_eq!(Iv::ENTIRE * Iv::new(-1.0, 0.0), Iv::ENTIRE);
         for iv in [
             Iv::new(f64::NEG_INFINITY, 0.0),
             Iv::new(0.0, f64::INFINITY),
@@ -503,6 +513,19 @@ mod tests {
                 assert!(c.lo <= cx && cx <= c.hi, "{i:?}: cos {x}");
                 (smin, smax) = (smin.min(sx), smax.max(sx));
                 (cmin, cmax) = (cmin.min(cx), cmax.max(cx));
+            }
+            // The ends' values are widened (libm is within one unit of sin and cos) where no
+            // extremum lies inside.
+            let two_units = |v: f64| 2.0 * f64::EPSILON * v.abs();
+            let (sa, ca) = lo.sin_cos();
+            let (sb, cb) = i.hi.sin_cos();
+            if s.lo > -1.0 && s.hi < 1.0 {
+                assert!(s.lo <= sa.min(sb) - two_units(sa.min(sb)), "{i:?}: {s:?}");
+                assert!(s.hi >= sa.max(sb) + two_units(sa.max(sb)), "{i:?}: {s:?}");
+            }
+            if c.lo > -1.0 && c.hi < 1.0 {
+                assert!(c.lo <= ca.min(cb) - two_units(ca.min(cb)), "{i:?}: {c:?}");
+                assert!(c.hi >= ca.max(cb) + two_units(ca.max(cb)), "{i:?}: {c:?}");
             }
             // The spacing's bound on what the samples miss, plus the widening of four units.
             let slack = (width / 256.0).powi(2) + 1e-15;
