@@ -285,16 +285,6 @@ mod tests {
             assert_eq!(iv.negative(), sign == Some(-1), "{iv:?}");
         }
         assert!(Iv::new(-1.0, 2.0).is_finite());
-        // The midpoint; x^(1/2) of an interval touching zero from below, and of one below it.
-        assert_eq!(Iv::new(1.0, 4.0).mid(), 2.5);
-        assert_eq!(Iv::new(-3.0, -2.0).mid(), -2.5);
-        assert_eq!(Iv::new(-1.0, 0.0).sqrt(), Iv::new(0.0, next_up(0.0)));
-        assert!(Iv::new(-2.0, -1.0).sqrt().lo.is_nan());
-        // 0 times an unbounded interval: exactly 0 for a zero-width zero, unbounded otherwise.
-        assert_eq!(Iv::point(0.0) * Iv::ENTIRE, Iv::point(0.0));
-        assert_eq!(Iv::ENTIRE * Iv::point(0.0), Iv::point(0.0));
-        assert_eq!(Iv::new(0.0, 1.0) * Iv::ENTIRE, Iv::ENTIRE);
-        assert_eq!(Iv::ENTIRE * Iv::new(-1.0, 0.0), Iv::ENTIRE);
         for iv in [
             Iv::new(f64::NEG_INFINITY, 0.0),
             Iv::new(0.0, f64::INFINITY),
@@ -304,6 +294,21 @@ mod tests {
         ] {
             assert!(!iv.is_finite(), "{iv:?}");
         }
+    }
+
+    /// The midpoint; the square root of an interval touching zero from below (zero) and of one
+    /// below it (NaN); 0 times an unbounded interval (exactly 0 for a zero-width zero, unbounded
+    /// otherwise).
+    #[test]
+    fn midpoint_square_root_at_zero_and_zero_times_unbounded() {
+        assert_eq!(Iv::new(1.0, 4.0).mid(), 2.5);
+        assert_eq!(Iv::new(-3.0, -2.0).mid(), -2.5);
+        assert_eq!(Iv::new(-1.0, 0.0).sqrt(), Iv::new(0.0, next_up(0.0)));
+        assert!(Iv::new(-2.0, -1.0).sqrt().lo.is_nan());
+        assert_eq!(Iv::point(0.0) * Iv::ENTIRE, Iv::point(0.0));
+        assert_eq!(Iv::ENTIRE * Iv::point(0.0), Iv::point(0.0));
+        assert_eq!(Iv::new(0.0, 1.0) * Iv::ENTIRE, Iv::ENTIRE);
+        assert_eq!(Iv::ENTIRE * Iv::new(-1.0, 0.0), Iv::ENTIRE);
     }
 
     /// Every operation's interval holds the exact result of sample points, checked against
