@@ -295,9 +295,13 @@ fn polish_postures(
         if k < n_proved && wrap_angle(q.theta1 - theta1).abs() > ROOT_POLISH_RAD {
             *certificate = Certificate::Unproved;
         }
+        // Scaled by the machine's size (L1), not only by |rho1|, which depends on where the
+        // slider's zero is: where leg I is stretched (a fold of eq. (10)), Newton stops a few
+        // 1e-6 mm from the posture, which the rounding fixes only to sqrt(eps) L1.
+        let same_mm = SAME_SOLUTION_MM * (1.0 + g.l1 + q.rho1.abs());
         let dup = pairs.iter().any(|o| {
             wrap_angle(o.theta1 - q.theta1).abs() < SAME_SOLUTION_RAD
-                && (o.rho1 - q.rho1).abs() < SAME_SOLUTION_MM * (1.0 + q.rho1.abs())
+                && (o.rho1 - q.rho1).abs() < same_mm
         });
         if dup {
             continue;

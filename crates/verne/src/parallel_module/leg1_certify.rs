@@ -602,27 +602,25 @@ mod tests {
         assert!(by_dd >= 200, "{by_dd}");
     }
 
-    /// The machine's inverse kinematics where leg I is fully stretched on Table II's set (alpha
-    /// = 0, yp = 0, rho1 = zp): F has a double root there, which only double-double decides,
-    /// and the radicand is zero to rounding. Every branch is found and proved (333 of 1,000 were
-    /// unproved when a radicand negative by rounding meant "leg I cannot reach"). |zp| >= 100 mm:
-    /// nearer zp = 0 the polish of the seeds at sin(alpha) = 0 ends a few 1e-6 mm from the proved
-    /// posture along the fold, farther than `SAME_SOLUTION_MM` (1 + |rho1|), and the duplicate
-    /// makes the result unproved (16 of 1,000 with zp anywhere; docs/reliability.md).
-    #[test]
-    fn machine_ik_at_a_stretched_leg1_on_table_ii_is_proved() {
+    /// Tool poses where leg I is fully stretched on Table II's set (alpha = 0, yp = 0, u^2 = K1,
+    /// so rho1 = zp), with zp of either sign and |zp| from `zp_min` to L1, on five machines: the
+    /// number of poses, how many of them came back unproved, and how many reported more than two
+    /// leg-I postures at the pose's theta1 (eq. (10) has at most two there). Each pose's
+    /// branch (from the module's inverse kinematics at P, alpha = 0) must be among the answers.
+    fn stretched_leg1_poses(seed: u64, zp_min: f64, zp_max: f64) -> (usize, usize, usize) {
         use crate::machine::{machine_ik, tool_pose_eq26};
         use crate::parallel_module::equations::ModulePose;
         use crate::parallel_module::ik::{solve, wrap_angle};
-        let mut unit = crate::math::test_rng::lcg(0x7ab1e2);
-        let (mut poses, mut unproved) = (0, 0);
+        let mut unit = crate::math::test_rng::lcg(seed);
+        let (mut poses, mut unproved, mut crowded) = (0, 0, 0);
         for m in &machines() {
             let g = &m.module;
             // u^2 = K1 at alpha = 0: rad = K1 - u^2 - yp^2 = 0.
             let u = (g.l1 * g.l1 - (g.r_big1 - g.r_small1).powi(2)).sqrt();
+            let zp_max = zp_max.min(g.l1);
             for k in 0..400 {
                 let x = if k % 2 == 0 { u } else { -u } - g.dx1;
-                let zp = (100.0 + unit() * (g.l1 - 100.0)) * if k % 4 < 2 { 1.0 } else { -1.0 };
+                let zp = (zp_min + unit() * (zp_max - zp_min)) * if k % 4 < 2 { 1.0 } else { -1.0 };
                 let p = Vector3::new(x, 0.0, zp);
                 let theta1 = (unit() - 0.5) * 2.0;
                 // Legs II and III reach only some of these points.
@@ -641,8 +639,45 @@ mod tests {
                 );
                 poses += 1;
                 unproved += usize::from(!ik.certificate.proved());
+                // Eq. (10) at one theta1 is quadratic in rho1: at most two postures (rho1 = zp
+                // +- h, one where h = 0).
+                let mut rho1s: Vec<f64> = ik
+                    .iter()
+                    .filter(|x| wrap_angle(x.theta1 - theta1).abs() < 1e-6)
+                    .map(|x| x.rho[0])
+                    .collect();
+                rho1s.sort_by(f64::total_cmp);
+                rho1s.dedup();
+                crowded += usize::from(rho1s.len() > 2);
             }
         }
-        assert!(poses >= 500 && unproved == 0, "{poses} {unproved}");
+        (poses, unproved, crowded)
+    }
+
+    /// The machine's inverse kinematics where leg I is fully stretched on Table II's set, |zp| >=
+    /// 100 mm: F has a double root there, which only double-double decides, and the radicand is
+    /// zero to rounding. Every branch is found once and proved (333 of 1,000 were unproved when a
+    /// radicand negative by rounding meant "leg I cannot reach").
+    #[test]
+    fn machine_ik_at_a_stretched_leg1_on_table_ii_is_proved() {
+        let (poses, unproved, crowded) = stretched_leg1_poses(0x7ab1e2, 100.0, f64::INFINITY);
+        assert!(
+            poses >= 500 && unproved == 0 && crowded == 0,
+            "{poses} {unproved} {crowded}"
+        );
+    }
+
+    /// The same with rho1 = zp within 100 mm of the slider's zero. The fold fixes rho1 only to
+    /// the square root of the rounding (a few 1e-6 mm), so the postures polished from the seeds
+    /// at sin(alpha) = 0 and from the proved root are the same posture a few 1e-6 mm apart: each
+    /// branch must be reported once (16 of 1,000 were reported three times, and unproved, when
+    /// the duplicate test scaled with 1 + |rho1|, which depends on where the slider's zero is).
+    #[test]
+    fn machine_ik_at_a_stretched_leg1_near_the_sliders_zero_reports_each_branch_once() {
+        let (poses, unproved, crowded) = stretched_leg1_poses(0x5afe_2e70, 0.0, 100.0);
+        assert!(
+            poses >= 500 && unproved == 0 && crowded == 0,
+            "{poses} {unproved} {crowded}"
+        );
     }
 }
