@@ -119,8 +119,8 @@ fn the_reported_triples_give_every_mode() {
 /// Where condition (21) (Det = 0), b = 0 and a tangent of leg I (Delta = 0: the two tau of
 /// eq. (10) on the line of eq. (14) are equal) meet at one alpha, two assembly modes merge at a
 /// zero of Det, and both factors of F lose their square root's smoothness. Four slider
-/// triples of the default machine do this (rho1 = 0; found by `mpmath.findroot` on Det = b =
-/// Delta = 0 at 40 digits, checked here to vanish to 1e-9 of their scales), shifted along rho2
+/// triples of the default machine do this (`DET_B_DELTA_ZERO`, rho1 = 0; checked here to vanish
+/// to 1e-9 of their scales), shifted along rho2
 /// by d from -1e-6 to 1e-6 mm and along all three sliders by 0, 300 and 1,700 mm. At 50 digits
 /// (the minimum of F next to alpha) each shift of 1e-10 mm or more has two modes on one side
 /// and none on the other; the solver must agree, and within 1e-12 mm give at most two, every
@@ -134,16 +134,7 @@ fn where_condition_21_meets_a_tangent_of_leg_i_both_modes_are_found() {
     let (r, rr, r2, r4) = (g.r_big1, g.r_small1, g.r_big2, g.r4);
     let delta = g.dx2 - g.dx1;
     let k0 = g.l1 * g.l1 - r * r - rr * rr;
-    for (p2, p3, alpha) in [
-        (
-            -1627.7550604132189,
-            -1627.8666764352438,
-            -4.787157408607968e-5,
-        ),
-        (1283.040403527657, 1283.1107411285327, -3.141465950265598),
-        (1627.7550604132189, 1627.8666764352438, 4.787157408607968e-5),
-        (-1283.040403527657, -1283.1107411285327, -3.1417193569139883),
-    ] {
+    for (p2, p3, alpha) in verne::selftest::hard_sets::DET_B_DELTA_ZERO {
         // The forms of the elimination (fk_certify's module documentation) at alpha.
         let (s, c) = f64::sin_cos(alpha);
         let b = g.l3 * g.l3 - g.l2 * g.l2 + (p2 + p3) * (p2 - p3) + 2.0 * r2 * (p2 + p3) * s;

@@ -125,6 +125,21 @@ impl HardSet {
     }
 }
 
+/// Where condition (21) (Det = 0), b = 0 and a tangent of leg I (Delta = 0: the two tau of
+/// eq. (10) on the line of eq. (14) are equal) meet at one alpha on the default machine: (rho2 -
+/// rho1, rho3 - rho1, alpha) (mm, mm, rad), found by `mpmath.findroot` on Det = b = Delta = 0
+/// at 40 digits and rounded to doubles. Two assembly modes merge there, at a zero of Det.
+pub const DET_B_DELTA_ZERO: [(f64, f64, f64); 4] = [
+    (
+        -1627.7550604132189,
+        -1627.8666764352438,
+        -4.787157408607968e-5,
+    ),
+    (1283.040403527657, 1283.1107411285327, -3.141465950265598),
+    (1627.7550604132189, 1627.8666764352438, 4.787157408607968e-5),
+    (-1283.040403527657, -1283.1107411285327, -3.1417193569139883),
+];
+
 /// Distances (mm) from the set along the line at which poses are taken: on it, and on both
 /// sides at 1e-9 to 0.1 mm.
 pub const OFFSETS_MM: [f64; 11] = [
