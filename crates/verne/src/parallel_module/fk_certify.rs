@@ -158,9 +158,22 @@ fn pose_from_tau(
     }
 }
 
+/// Rounded operations on any path from an input to Delta at a point (the forms' coefficients,
+/// then 4 K1 (Q^2 + delta^2 N) - N A^2): a generous count, as for `CHARACTERISTIC_OPS`.
+const DISC_OPS: f64 = 64.0;
+
+/// A bound on the rounding of Delta as [`factors_at`] computes it at (sin a, cos a):
+/// `DISC_OPS` roundings of the magnitude of its formula ([`Mag`]). Where leg I is tangent
+/// (Delta = 0 at a root of F), Delta comes out of either sign; negative by less than this, it is
+/// zero (as `leg1_radicand` does for leg I's posture).
+fn disc_error(g: &ModuleGeometry, rho: &Sliders, (s, c): (f64, f64)) -> f64 {
+    let m = factors_at(&forms::<Mag>(g, rho), Mag::from(s), Mag::from(c));
+    DISC_OPS * f64::EPSILON * m.disc.0
+}
+
 /// The pose at a root of F where Det is too small for the linear solution (condition (21)): the
 /// factor g+- the root belongs to (the smaller |g| there) gives tau and the pose. None where H1
-/// has no real root in tau.
+/// has no real root in tau (Delta negative beyond its rounding, [`disc_error`]).
 pub(crate) fn pose_at_root_by_factors(
     g: &ModuleGeometry,
     rho: &Sliders,
@@ -169,10 +182,10 @@ pub(crate) fn pose_at_root_by_factors(
 ) -> Option<ModulePose> {
     let f = forms::<f64>(g, rho);
     let fa = factors_at(&f, sc.0, sc.1);
-    if !(fa.disc >= 0.0 && fa.p4 > 0.0) {
+    if !(fa.disc >= -disc_error(g, rho, sc) && fa.p4 > 0.0) {
         return None;
     }
-    let root = f.delta.abs() * fa.disc.sqrt();
+    let root = f.delta.abs() * fa.disc.max(0.0).sqrt();
     let tau = [(-fa.a * fa.q + root), (-fa.a * fa.q - root)].map(|n| n / (2.0 * fa.p4));
     let g_of = |t: f64| (t * fa.det - fa.b).abs();
     let tau = if g_of(tau[0]) <= g_of(tau[1]) {
@@ -304,16 +317,23 @@ pub(crate) fn resolve(
         }
         let tf = forms::<Tracked>(g, rho);
         let found = certify::dd_roots(|at_pi| half_angle_poly(&tf, at_pi), lo, hi);
+        // False where no start pose could be built at x.
         let push = |to: &mut ArrayVec<ProvedStart, 40>, x: f64| {
             let sc = x.sin_cos();
-            if let Some(pose) = start_at(g, rho, x, sc) {
+            let pose = start_at(g, rho, x, sc);
+            if let Some(pose) = pose {
                 let _ = to.try_push(ProvedStart { pose, sc });
             }
+            pose.is_some()
         };
         match found {
             Ok(found) if found.decided_up_to_same_root() => {
                 worst = worst.max(Resolution::Extended);
-                found.roots.iter().for_each(|&x| push(starts, x));
+                // A proved root without its start would be a mode dropped: never silently.
+                let built = found.roots.iter().filter(|&&x| push(starts, x)).count();
+                if built < found.roots.len() {
+                    worst = Resolution::Unproved;
+                }
                 for [a, b] in found.undecided {
                     push(allowed, 0.5 * (a + b));
                     let _ = undecided.try_push([a, b]);
@@ -323,11 +343,12 @@ pub(crate) fn resolve(
                 // Best effort where nothing is proved: what was found, and the midpoints.
                 worst = Resolution::Unproved;
                 if let Ok(found) = other {
-                    found.roots.iter().for_each(|&x| push(fallback, x));
-                    found
-                        .undecided
-                        .iter()
-                        .for_each(|[a, b]| push(fallback, 0.5 * (a + b)));
+                    for &x in &found.roots {
+                        push(fallback, x);
+                    }
+                    for [a, b] in found.undecided {
+                        push(fallback, 0.5 * (a + b));
+                    }
                 }
                 push(fallback, 0.5 * (lo + hi));
             }
@@ -405,4 +426,53 @@ pub fn dd_root_angles(g: &ModuleGeometry, rho: &Sliders, lo: f64, hi: f64) -> Op
     let tf = forms::<Tracked>(g, rho);
     let out = certify::dd_roots(|at_pi| half_angle_poly(&tf, at_pi), lo, hi).ok()?;
     out.undecided.is_empty().then(|| out.roots.to_vec())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{disc_error, factors_at, forms, pose_at_root_by_factors};
+    use crate::parallel_module::equations::residual_mm;
+    use crate::selftest::hard_sets::DET_B_DELTA_ZERO;
+    use crate::spec::Machine;
+    use nalgebra::Vector3;
+
+    /// Where Det = b = Delta = 0 at one alpha (`DET_B_DELTA_ZERO`, shifted along all three
+    /// sliders), the pose from the factors at the root and at 128 angles within 6.4e-16 (1 +
+    /// |alpha|) of it, where Delta is zero to rounding and comes out of either sign: every one is
+    /// built and closes the four loops within 1e-9 mm. A strict Delta >= 0 refused 27 to 70 of
+    /// the 129 on each triple. Where Delta is negative beyond its rounding (1e-6 rad from the
+    /// root, on the side where leg I cannot reach), there is no pose.
+    #[test]
+    fn the_pose_at_a_tangent_of_leg_i_is_built_where_delta_is_zero_to_rounding() {
+        let m = Machine::default_verne();
+        let g = &m.module;
+        for (p2, p3, alpha) in DET_B_DELTA_ZERO {
+            for rho1 in [0.0, 300.0, 1700.0] {
+                let rho = Vector3::new(rho1, rho1 + p2, rho1 + p3);
+                let f = forms::<f64>(g, &rho);
+                for k in -64i32..=64 {
+                    let a = alpha + f64::from(k) * 1e-17 * (1.0 + alpha.abs());
+                    let sc = a.sin_cos();
+                    let disc = factors_at(&f, sc.0, sc.1).disc;
+                    assert!(disc.abs() <= disc_error(g, &rho, sc), "{rho:?} {a}: {disc}");
+                    let pose = pose_at_root_by_factors(g, &rho, a, sc);
+                    let Some(pose) = pose else {
+                        panic!("{rho:?} {a}: Delta {disc}: no pose");
+                    };
+                    let res = residual_mm(g, &pose, &rho);
+                    assert!(res < 1e-9, "{rho:?} {a}: residual {res} mm");
+                }
+                let outside: Vec<f64> = [alpha - 1e-6, alpha + 1e-6]
+                    .into_iter()
+                    .filter(|a| {
+                        let sc = a.sin_cos();
+                        factors_at(&f, sc.0, sc.1).disc < -disc_error(g, &rho, sc)
+                    })
+                    .collect();
+                assert_eq!(outside.len(), 1, "{rho:?}");
+                let sc = outside[0].sin_cos();
+                assert!(pose_at_root_by_factors(g, &rho, outside[0], sc).is_none());
+            }
+        }
+    }
 }
