@@ -430,11 +430,74 @@ pub fn dd_root_angles(g: &ModuleGeometry, rho: &Sliders, lo: f64, hi: f64) -> Op
 
 #[cfg(test)]
 mod tests {
-    use super::{disc_error, factors_at, forms, pose_at_root_by_factors};
+    use super::{
+        CHARACTERISTIC_OPS, characteristic_error, disc_error, factors_at, forms,
+        pose_at_root_by_factors,
+    };
+    use crate::math::dd::Tracked;
     use crate::parallel_module::equations::residual_mm;
-    use crate::selftest::hard_sets::DET_B_DELTA_ZERO;
+    use crate::selftest::hard_sets::{DET_B_DELTA_ZERO, random_geometries};
     use crate::spec::Machine;
     use nalgebra::Vector3;
+
+    /// [`characteristic_error`] bounds the rounding of F as `fk::characteristic` computes it. At
+    /// 64 angles, F in double precision lies within the bound of F in double-double (the module
+    /// documentation's formula U^2 + 4 delta^2 (b^2 N - K1 Det^2) from the exact inputs, its own
+    /// error added); and the bound is at least [`CHARACTERISTIC_OPS`] roundings of the formula's
+    /// magnitude at every angle ([`Tracked`]'s, computed term by term at that angle) and at most
+    /// 4 times the largest (measured up to 1.8; F's actual error up to 0.0074 of the bound). Sliders from 1 to 1e5 mm on the default machine
+    /// and four random ones, and the triples of `DET_B_DELTA_ZERO`.
+    #[test]
+    fn characteristic_error_covers_the_rounding_of_f() {
+        let mut unit = crate::math::test_rng::lcg(0xc4a2_e770);
+        let mut machines = vec![Machine::default_verne()];
+        machines.extend(random_geometries(4, 15));
+        let mut loosest = 0.0f64;
+        for (i, m) in machines.iter().enumerate() {
+            let g = &m.module;
+            let mut triples: Vec<Vector3<f64>> = (0..2_000)
+                .map(|k| {
+                    let span = [1.0, 1e3, 3e3, 1e5][k % 4];
+                    Vector3::new(unit() - 0.5, unit() - 0.5, unit() - 0.5) * span
+                })
+                .collect();
+            if i == 0 {
+                triples.extend(
+                    DET_B_DELTA_ZERO.map(|(p2, p3, _)| Vector3::new(250.0, 250.0 + p2, 250.0 + p3)),
+                );
+            }
+            for rho in &triples {
+                let bound = characteristic_error(g, rho);
+                let f64_f = crate::parallel_module::fk::characteristic(g, rho);
+                let t = forms::<Tracked>(g, rho);
+                let mut largest = 0.0f64;
+                for k in 0..64 {
+                    let (s, c) = (std::f64::consts::TAU * (f64::from(k) + unit()) / 64.0).sin_cos();
+                    let (ts, tc) = (Tracked::exact(s), Tracked::exact(c));
+                    let det = t.det.at(ts, tc);
+                    let b = t.b.at(ts, tc);
+                    let u = t.a.at(ts, tc) * det + Tracked::from(2.0) * b * t.q.at(ts, tc);
+                    let inner = b * b * t.n.at(ts, tc) - t.k1.at(ts, tc) * det * det;
+                    let f = u * u + Tracked::from(4.0) * t.delta * t.delta * inner;
+                    let err = (f64_f.eval_sc(s, c) - f.v.to_f64()).abs();
+                    assert!(
+                        err <= bound + f.error(64) + f64::EPSILON * f.v.to_f64().abs(),
+                        "{}: {rho:?} at ({s}, {c}): F off by {err:e}, bound {bound:e}",
+                        m.name
+                    );
+                    largest = largest.max(f.mag);
+                }
+                let floor = CHARACTERISTIC_OPS * f64::EPSILON * largest;
+                assert!(
+                    bound >= floor * (1.0 - 1e-12) && bound <= 4.0 * floor,
+                    "{}: {rho:?}: bound {bound:e}, magnitude's rounding {floor:e}",
+                    m.name
+                );
+                loosest = loosest.max(bound / floor);
+            }
+        }
+        assert!(loosest > 1.0, "{loosest}");
+    }
 
     /// Where Det = b = Delta = 0 at one alpha (`DET_B_DELTA_ZERO`, shifted along all three
     /// sliders), the pose from the factors at the root and at 128 angles within 6.4e-16 (1 +
