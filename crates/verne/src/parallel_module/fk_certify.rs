@@ -393,41 +393,6 @@ fn half_angle_poly(f: &Forms<Tracked>, at_pi: bool) -> Poly8 {
     add::<9>(&mul::<5, 5, 9>(&u, &u), &scale(&inner, d2))
 }
 
-/// For tests: the proved roots of the two factors over [lo, hi], as angles.
-#[doc(hidden)]
-pub fn factor_root_angles(g: &ModuleGeometry, rho: &Sliders, lo: f64, hi: f64) -> Option<Vec<f64>> {
-    let fi = forms::<Iv>(g, rho);
-    let ff = forms::<f64>(g, rho);
-    let factors = [1.0, -1.0].map(|sigma| FkFactor {
-        iv: &fi,
-        f64: &ff,
-        sigma,
-    });
-    let roots = certify::all_factor_roots(&factors, lo, hi).ok()?;
-    Some(roots.iter().map(|r| r.1).collect())
-}
-
-/// For tests: what double-double proves over [lo, hi]: roots and undecided intervals, as angles.
-#[doc(hidden)]
-pub fn dd_root_angles_full(
-    g: &ModuleGeometry,
-    rho: &Sliders,
-    lo: f64,
-    hi: f64,
-) -> Option<(Vec<f64>, Vec<[f64; 2]>)> {
-    let tf = forms::<Tracked>(g, rho);
-    let out = certify::dd_roots(|at_pi| half_angle_poly(&tf, at_pi), lo, hi).ok()?;
-    Some((out.roots.to_vec(), out.undecided.to_vec()))
-}
-
-/// For tests: the proved roots of F over [lo, hi] in double-double, as angles.
-#[doc(hidden)]
-pub fn dd_root_angles(g: &ModuleGeometry, rho: &Sliders, lo: f64, hi: f64) -> Option<Vec<f64>> {
-    let tf = forms::<Tracked>(g, rho);
-    let out = certify::dd_roots(|at_pi| half_angle_poly(&tf, at_pi), lo, hi).ok()?;
-    out.undecided.is_empty().then(|| out.roots.to_vec())
-}
-
 #[cfg(test)]
 mod tests {
     use super::{
