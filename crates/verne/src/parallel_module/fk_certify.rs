@@ -396,7 +396,7 @@ fn half_angle_poly(f: &Forms<Tracked>, at_pi: bool) -> Poly8 {
 #[cfg(test)]
 mod tests {
     use super::{
-        CHARACTERISTIC_OPS, characteristic_error, disc_error, factors_at, forms,
+        CHARACTERISTIC_OPS, FkFactor, characteristic_error, disc_error, factors_at, forms,
         pose_at_root_by_factors,
     };
     use crate::math::dd::Tracked;
@@ -415,8 +415,7 @@ mod tests {
     #[test]
     fn characteristic_error_covers_the_rounding_of_f() {
         let mut unit = crate::math::test_rng::lcg(0xc4a2_e770);
-        let mut machines = vec![Machine::default_verne()];
-        machines.extend(random_geometries(4, 15));
+        let machines = machines();
         let mut loosest = 0.0f64;
         for (i, m) in machines.iter().enumerate() {
             let g = &m.module;
@@ -464,6 +463,185 @@ mod tests {
         assert!(loosest > 1.0, "{loosest}");
     }
 
+    /// The default machine and four random valid geometries.
+    fn machines() -> Vec<Machine> {
+        let mut out = vec![Machine::default_verne()];
+        out.extend(random_geometries(4, 15));
+        out
+    }
+
+    /// Slider triples for the factors' tests: within 500 mm of each other (where modes are)
+    /// and from 3,000 mm to 1e4 mm apart.
+    fn triples(unit: &mut impl FnMut() -> f64, count: usize) -> Vec<Vector3<f64>> {
+        (0..count)
+            .map(|k| {
+                let span = [500.0, 3e3, 1e4][k % 3];
+                Vector3::new(unit() - 0.5, unit() - 0.5, unit() - 0.5) * span
+            })
+            .collect()
+    }
+
+    /// F is the product of its factors: P g+ g- = F (module documentation, P = 4 (Q^2 + delta^2
+    /// N)) at every angle where Delta > 0, F from `fk::characteristic`, to 1e-9 of the
+    /// magnitude of its formula; and each factor's slope is its derivative (a central difference
+    /// of the value, step 1e-6 rad, to 1e-5 of the slope's scale). 600 triples on five machines,
+    /// 64 angles each.
+    #[test]
+    fn the_factors_multiply_to_f_and_their_slopes_are_their_derivatives() {
+        use crate::math::certify::Factor;
+        use crate::math::interval::Iv;
+        let mut unit = crate::math::test_rng::lcg(0x0fac_7012);
+        let mut checked = 0;
+        for m in &machines() {
+            let g = &m.module;
+            for rho in triples(&mut unit, 120) {
+                let (fi, ff) = (forms::<Iv>(g, &rho), forms::<f64>(g, &rho));
+                let big_f = crate::parallel_module::fk::characteristic(g, &rho);
+                let scale = characteristic_error(g, &rho) / (CHARACTERISTIC_OPS * f64::EPSILON);
+                let [plus, minus] = [1.0, -1.0].map(|sigma| FkFactor {
+                    iv: &fi,
+                    f64: &ff,
+                    sigma,
+                });
+                for _ in 0..64 {
+                    let x = (unit() - 0.5) * 6.5;
+                    let (Some((gp, dgp)), Some((gm, dgm))) = (plus.value(x), minus.value(x)) else {
+                        continue;
+                    };
+                    let (s, c) = x.sin_cos();
+                    let p4 = factors_at(&ff, s, c).p4;
+                    let (product, f) = (4.0 * p4 * gp * gm, big_f.eval_sc(s, c));
+                    assert!(
+                        (product - f).abs() <= 1e-9 * scale,
+                        "{}: {rho:?} at {x}: P g+ g- = {product:e}, F = {f:e}",
+                        m.name
+                    );
+                    for (factor, slope) in [(&plus, dgp), (&minus, dgm)] {
+                        let h = 1e-6;
+                        let (Some((up, _)), Some((down, _))) =
+                            (factor.value(x + h), factor.value(x - h))
+                        else {
+                            continue;
+                        };
+                        let diff = (up - down) / (2.0 * h);
+                        let size = slope.abs().max(diff.abs()).max(1e-3 * scale.sqrt());
+                        assert!(
+                            (diff - slope).abs() <= 1e-5 * size,
+                            "{}: {rho:?} at {x}: slope {slope:e}, difference {diff:e}",
+                            m.name
+                        );
+                        checked += 1;
+                    }
+                }
+            }
+        }
+        assert!(checked > 20_000, "{checked}");
+    }
+
+    /// The factors' values and slopes in double precision (for Newton's steps) are the
+    /// enclosures' own: at every angle where `value` gives them, they lie in `over(x, x)`'s
+    /// intervals (widened by four times their width and 1e-12 relative, for the double
+    /// evaluation's rounding); where `over` proves there is no solution, `value` gives nothing;
+    /// and over an interval, the enclosures hold the values at its sample points.
+    #[test]
+    fn factor_values_lie_in_their_enclosures() {
+        use crate::math::certify::{Enclosure, Factor};
+        use crate::math::interval::Iv;
+        let mut unit = crate::math::test_rng::lcg(0x0fac_7013);
+        let within = |v: f64, iv: Iv| {
+            let slack = 4.0 * (iv.hi - iv.lo) + 1e-12 * iv.lo.abs().max(iv.hi.abs());
+            v >= iv.lo - slack && v <= iv.hi + slack
+        };
+        let (mut checked, mut none, mut spans) = (0, 0, 0);
+        for m in &machines() {
+            let g = &m.module;
+            for rho in triples(&mut unit, 120) {
+                let (fi, ff) = (forms::<Iv>(g, &rho), forms::<f64>(g, &rho));
+                for sigma in [1.0, -1.0] {
+                    let f = FkFactor {
+                        iv: &fi,
+                        f64: &ff,
+                        sigma,
+                    };
+                    for _ in 0..64 {
+                        let x = (unit() - 0.5) * 6.5;
+                        match (f.over(x, x), f.value(x)) {
+                            (Enclosure::Values { g, dg }, Some((v, d))) => {
+                                assert!(
+                                    within(v, g) && within(d, dg),
+                                    "{rho:?} sigma {sigma} x {x}: ({v}, {d}) against {g:?}, {dg:?}"
+                                );
+                                checked += 1;
+                            }
+                            (Enclosure::NoSolution, v) => {
+                                assert!(v.is_none(), "{rho:?} x {x}: {v:?}");
+                                none += 1;
+                            }
+                            _ => {}
+                        }
+                        let (lo, hi) = (x, x + 1e-3 * unit());
+                        if let Enclosure::Values { g, dg } = f.over(lo, hi) {
+                            for k in 0..=4 {
+                                let y = lo + (hi - lo) * f64::from(k) / 4.0;
+                                if let Some((v, d)) = f.value(y) {
+                                    assert!(
+                                        within(v, g) && within(d, dg),
+                                        "{rho:?} [{lo}, {hi}] at {y}"
+                                    );
+                                    spans += 1;
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(
+            checked > 20_000 && none > 20_000 && spans > 50_000,
+            "{checked} {none} {spans}"
+        );
+    }
+
+    /// The half-angle polynomial of the double-double path is (1 + t^2)^4 F: in each chart (t =
+    /// tan(x / 2) about 0, tan((x - pi) / 2) about pi), its value at 32 angles of the chart
+    /// agrees with F(x) (1 + t^2)^4, F from `fk::characteristic`, to 1e-12 of the terms'
+    /// magnitudes. 600 triples on five machines.
+    #[test]
+    fn half_angle_polynomial_is_f_times_its_denominator() {
+        use super::half_angle_poly;
+        let mut unit = crate::math::test_rng::lcg(0x4a1f_f001);
+        let mut checked = 0;
+        for m in &machines() {
+            let g = &m.module;
+            for rho in triples(&mut unit, 120) {
+                let big_f = crate::parallel_module::fk::characteristic(g, &rho);
+                let scale = characteristic_error(g, &rho) / (CHARACTERISTIC_OPS * f64::EPSILON);
+                let tf = forms::<Tracked>(g, &rho);
+                for (at_pi, centre) in [(false, 0.0), (true, std::f64::consts::PI)] {
+                    let coefficients = half_angle_poly(&tf, at_pi).map(|c| c.v.to_f64());
+                    for _ in 0..32 {
+                        let x = centre + (unit() - 0.5) * std::f64::consts::PI;
+                        let t = (0.5 * (x - centre)).tan();
+                        let (value, size) = coefficients
+                            .iter()
+                            .rev()
+                            .fold((0.0, 0.0), |(v, a), c| (v * t + c, a * t.abs() + c.abs()));
+                        let (s, c) = x.sin_cos();
+                        let w = (1.0 + t * t).powi(4);
+                        let f = big_f.eval_sc(s, c) * w;
+                        assert!(
+                            (value - f).abs() <= 1e-12 * (size + scale * w),
+                            "{}: {rho:?} x {x} ({at_pi}): {value:e} against {f:e}",
+                            m.name
+                        );
+                        checked += 1;
+                    }
+                }
+            }
+        }
+        assert_eq!(checked, 38_400);
+    }
+
     /// Next to condition (21) (Det = 0 at the pose's alpha, `HardSet::Condition21`, and the
     /// plane where L2 = L3 makes every zero of Det a double root, `HardSet::SliderMean`), the
     /// factors' pose at a built pose's alpha is that pose (within 1e-8 mm; measured 3e-11), the
@@ -475,10 +653,8 @@ mod tests {
     fn the_factors_give_the_built_mode_next_to_condition_21() {
         use crate::selftest::hard_sets::{HardSet, Sampler, construct, random_start};
         let mut rng = Sampler::new(0x0021_fac7);
-        let mut machines = vec![Machine::default_verne()];
-        machines.extend(random_geometries(4, 15));
         let mut poses = 0;
-        for m in &machines {
+        for m in &machines() {
             for set in [HardSet::Condition21, HardSet::SliderMean] {
                 let mut m = m.clone();
                 if set == HardSet::SliderMean {
