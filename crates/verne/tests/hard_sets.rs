@@ -120,8 +120,8 @@ fn the_reported_triples_give_every_mode() {
 /// eq. (10) on the line of eq. (14) are equal) meet at one alpha, two assembly modes merge at a
 /// zero of Det, and both factors of F lose their square root's smoothness. Four slider
 /// triples of the default machine do this (`DET_B_DELTA_ZERO`, rho1 = 0; checked here to vanish
-/// to 1e-9 of their scales), shifted along rho2
-/// by d from -1e-6 to 1e-6 mm and along all three sliders by 0, 300 and 1,700 mm. At 50 digits
+/// to 1e-9 of their scales), shifted along rho2 by d from -1e-6 to 1e-6 mm and along all three
+/// sliders by 0, 300 and 1,700 mm. At 50 digits
 /// (the minimum of F next to alpha) each shift of 1e-10 mm or more has two modes on one side
 /// and none on the other; the solver must agree, and within 1e-12 mm give at most two, every
 /// answer proved and every mode within 1e-9 mm of closing.
