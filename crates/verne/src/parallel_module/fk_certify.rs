@@ -647,7 +647,7 @@ mod tests {
     /// factors' pose at a built pose's alpha is that pose (within 1e-8 mm; measured 3e-11), the
     /// mode of its own factor and not the other's: poses built at 1e-9 to 0.1 mm either side of
     /// the set on five machines. On the set itself both modes share alpha (b = 0 there too) and
-    /// either may come out (the other 1,000 mm or more away in 23 of 81; the fixed-angle points
+    /// either may come out (the other, 990 to 1,550 mm away, in 23 of 81; the fixed-angle points
     /// find both): the pose must close the four loops within 1e-8 mm.
     #[test]
     fn the_factors_give_the_built_mode_next_to_condition_21() {
