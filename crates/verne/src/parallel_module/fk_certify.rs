@@ -410,8 +410,9 @@ mod tests {
     /// documentation's formula U^2 + 4 delta^2 (b^2 N - K1 Det^2) from the exact inputs, its own
     /// error added); and the bound is at least [`CHARACTERISTIC_OPS`] roundings of the formula's
     /// magnitude at every angle ([`Tracked`]'s, computed term by term at that angle) and at most
-    /// 4 times the largest (measured up to 1.8; F's actual error up to 0.0074 of the bound). Sliders from 1 to 1e5 mm on the default machine
-    /// and four random ones, and the triples of `DET_B_DELTA_ZERO`.
+    /// 4 times the largest (measured up to 1.8; F's actual error up to 0.0074 of the bound).
+    /// Sliders from 1 to 1e5 mm on the default machine and four random ones, and the triples of
+    /// `DET_B_DELTA_ZERO`.
     #[test]
     fn characteristic_error_covers_the_rounding_of_f() {
         let mut unit = crate::math::test_rng::lcg(0xc4a2_e770);
