@@ -497,6 +497,35 @@ impl Polys<'_> {
     }
 }
 
+/// For the factors' tests (leg I's and the forward kinematics'): whether `v` lies in `iv`
+/// widened for the double evaluation's rounding (four times its width and 1e-12 relative).
+#[cfg(test)]
+pub(crate) fn within_enclosure(v: f64, iv: Iv) -> bool {
+    let slack = 4.0 * (iv.hi - iv.lo) + 1e-12 * iv.lo.abs().max(iv.hi.abs());
+    v >= iv.lo - slack && v <= iv.hi + slack
+}
+
+/// For the factors' tests: a factor's double-precision value and slope at `x` against its
+/// enclosure over [x, x]. `Ok(Some(true))` where both give values and the values lie in the
+/// enclosures ([`within_enclosure`]), `Ok(Some(false))` where the enclosure proves no solution
+/// and `value` gives nothing, `Ok(None)` where there is nothing to compare, and `Err` (what
+/// disagreed) otherwise.
+#[cfg(test)]
+pub(crate) fn value_against_enclosure(f: &impl Factor, x: f64) -> Result<Option<bool>, String> {
+    match (f.over(x, x), f.value(x)) {
+        (Enclosure::Values { g, dg }, Some((v, d))) => {
+            if within_enclosure(v, g) && within_enclosure(d, dg) {
+                Ok(Some(true))
+            } else {
+                Err(format!("({v}, {d}) against {g:?}, {dg:?}"))
+            }
+        }
+        (Enclosure::NoSolution, None) => Ok(Some(false)),
+        (Enclosure::NoSolution, v) => Err(format!("{v:?} where no solution is proved")),
+        _ => Ok(None),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

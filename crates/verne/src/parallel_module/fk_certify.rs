@@ -546,13 +546,9 @@ mod tests {
     /// and over an interval, the enclosures hold the values at its sample points.
     #[test]
     fn factor_values_lie_in_their_enclosures() {
-        use crate::math::certify::{Enclosure, Factor};
+        use crate::math::certify::{Enclosure, Factor, value_against_enclosure, within_enclosure};
         use crate::math::interval::Iv;
         let mut unit = crate::math::test_rng::lcg(0x0fac_7013);
-        let within = |v: f64, iv: Iv| {
-            let slack = 4.0 * (iv.hi - iv.lo) + 1e-12 * iv.lo.abs().max(iv.hi.abs());
-            v >= iv.lo - slack && v <= iv.hi + slack
-        };
         let (mut checked, mut none, mut spans) = (0, 0, 0);
         for m in &machines() {
             let g = &m.module;
@@ -566,19 +562,11 @@ mod tests {
                     };
                     for _ in 0..64 {
                         let x = (unit() - 0.5) * 6.5;
-                        match (f.over(x, x), f.value(x)) {
-                            (Enclosure::Values { g, dg }, Some((v, d))) => {
-                                assert!(
-                                    within(v, g) && within(d, dg),
-                                    "{rho:?} sigma {sigma} x {x}: ({v}, {d}) against {g:?}, {dg:?}"
-                                );
-                                checked += 1;
-                            }
-                            (Enclosure::NoSolution, v) => {
-                                assert!(v.is_none(), "{rho:?} x {x}: {v:?}");
-                                none += 1;
-                            }
-                            _ => {}
+                        match value_against_enclosure(&f, x) {
+                            Ok(Some(true)) => checked += 1,
+                            Ok(Some(false)) => none += 1,
+                            Ok(None) => {}
+                            Err(e) => panic!("{rho:?} sigma {sigma} x {x}: {e}"),
                         }
                         let (lo, hi) = (x, x + 1e-3 * unit());
                         if let Enclosure::Values { g, dg } = f.over(lo, hi) {
@@ -586,7 +574,7 @@ mod tests {
                                 let y = lo + (hi - lo) * f64::from(k) / 4.0;
                                 if let Some((v, d)) = f.value(y) {
                                     assert!(
-                                        within(v, g) && within(d, dg),
+                                        within_enclosure(v, g) && within_enclosure(d, dg),
                                         "{rho:?} [{lo}, {hi}] at {y}"
                                     );
                                     spans += 1;
