@@ -328,6 +328,8 @@ pub(crate) fn dd_roots(poly: impl Fn(bool) -> Poly8, lo: f64, hi: f64) -> Result
     use std::f64::consts::{FRAC_PI_2, PI};
     let mut charts: [Option<Poly8>; 2] = [None, None];
     let mut out = DdRoots::default();
+    // The roots the previous piece found next to the cut it shares with this one.
+    let mut at_cut: ArrayVec<f64, 16> = ArrayVec::new();
     for (clo, chi) in chart_pieces(lo, hi) {
         let mid = 0.5 * (clo + chi);
         let at_pi = !(-FRAC_PI_2..=FRAC_PI_2).contains(&mid);
@@ -343,16 +345,38 @@ pub(crate) fn dd_roots(poly: impl Fn(bool) -> Poly8, lo: f64, hi: f64) -> Result
         let widen = |t: f64, dir: f64| t + dir * 4.0 * f64::EPSILON * t.abs().max(1e-300);
         let found = poly_roots(&p, widen(t_of(clo), -1.0), widen(t_of(chi), 1.0))?;
         let angle = |t: f64| centre + 2.0 * t.atan();
-        for t in found.roots {
-            out.roots.try_push(angle(t)).map_err(|_| ())?;
+        let first = out.roots.len();
+        for x in found.roots.into_iter().map(angle) {
+            // Both pieces' widened ends hold a root at their cut: it is found twice.
+            if next_to_cut(x, clo) {
+                if let Some(k) = at_cut.iter().position(|&y| next_to_cut(x, y)) {
+                    at_cut.swap_remove(k);
+                    continue;
+                }
+            }
+            out.roots.try_push(x).map_err(|_| ())?;
         }
+        at_cut = out.roots[first..]
+            .iter()
+            .copied()
+            .filter(|&x| next_to_cut(x, chi))
+            .collect();
         for [a, b] in found.undecided {
-            out.undecided
-                .try_push([angle(a), angle(b)])
-                .map_err(|_| ())?;
+            let (a, b) = (angle(a), angle(b));
+            match out.undecided.last_mut() {
+                // An interval across the cut, as each piece saw it: one interval.
+                Some(last) if a <= last[1] => last[1] = last[1].max(b),
+                _ => out.undecided.try_push([a, b]).map_err(|_| ())?,
+            }
         }
     }
     Ok(out)
+}
+
+/// Whether the angle x lies within the overlap of two chart pieces' widened ends at `cut` (four
+/// units of t each, a few units of the angle), with room for the rounding of the angle.
+fn next_to_cut(x: f64, cut: f64) -> bool {
+    (x - cut).abs() <= 16.0 * f64::EPSILON * cut.abs().max(1.0)
 }
 
 /// Every root of the polynomial `p` (double-double with magnitudes, lowest degree first) in
@@ -550,6 +574,424 @@ mod tests {
             (t[0] - 0.25).abs() < 1e-15 && (t[1] - 0.25 - 1e-13).abs() < 1e-15,
             "{t:?}"
         );
+    }
+
+    use std::f64::consts::{FRAC_PI_2, PI};
+
+    /// (x - a)(x - b) with its enclosures by interval arithmetic; no solution below `floor`
+    /// (where a radicand would be negative), and enclosures over the part at or above it.
+    struct Quadratic {
+        a: f64,
+        b: f64,
+        floor: f64,
+    }
+
+    impl Factor for Quadratic {
+        fn over(&self, lo: f64, hi: f64) -> Enclosure {
+            if hi < self.floor {
+                return Enclosure::NoSolution;
+            }
+            let x = Iv::new(lo.max(self.floor), hi);
+            Enclosure::Values {
+                g: (x - Iv::point(self.a)) * (x - Iv::point(self.b)),
+                dg: x * 2.0 - Iv::point(self.a) - Iv::point(self.b),
+            }
+        }
+        fn value(&self, x: f64) -> Option<(f64, f64)> {
+            (x >= self.floor).then(|| ((x - self.a) * (x - self.b), 2.0 * x - self.a - self.b))
+        }
+    }
+
+    /// sin(x) - level, enclosed with `Iv::sin_cos`.
+    struct SineLevel(f64);
+
+    impl Factor for SineLevel {
+        fn over(&self, lo: f64, hi: f64) -> Enclosure {
+            let (s, c) = Iv::new(lo, hi).sin_cos();
+            Enclosure::Values {
+                g: s - Iv::point(self.0),
+                dg: c,
+            }
+        }
+        fn value(&self, x: f64) -> Option<(f64, f64)> {
+            Some((x.sin() - self.0, x.cos()))
+        }
+    }
+
+    fn roots_of(f: &impl Factor, lo: f64, hi: f64) -> Result<Vec<f64>, ()> {
+        let mut out = ArrayVec::new();
+        factor_roots(f, lo, hi, 0, &mut MAX_PIECES.clone(), &mut out)?;
+        Ok(out.to_vec())
+    }
+
+    /// Within `ulps` units in the last place of `want`.
+    fn close(got: f64, want: f64, ulps: f64) -> bool {
+        (got - want).abs() <= ulps * f64::EPSILON * want.abs().max(f64::MIN_POSITIVE)
+    }
+
+    /// Each simple root once, in order, to the last few bits: apart, 1e-9 apart, on the first
+    /// split point (g = 0 exactly there: the split moves), and of a sine (whose enclosure is
+    /// the whole [-1, 1] on wide pieces).
+    #[test]
+    fn factor_roots_proves_each_simple_root_once() {
+        for (a, b) in [(0.3, 0.7), (0.3, 0.3 + 1e-9), (0.5, 0.75), (-0.25, 0.5)] {
+            let f = Quadratic {
+                a,
+                b,
+                floor: f64::NEG_INFINITY,
+            };
+            let r = roots_of(&f, -1.0, 1.0).unwrap();
+            assert_eq!(r.len(), 2, "({a}, {b}): {r:?}");
+            assert!(
+                close(r[0], a, 4.0) && close(r[1], b, 4.0),
+                "({a}, {b}): {r:?}"
+            );
+        }
+        let r = roots_of(&SineLevel(0.5), -PI, PI).unwrap();
+        assert_eq!(r.len(), 2, "{r:?}");
+        assert!(
+            close(r[0], PI / 6.0, 4.0) && close(r[1], 5.0 * PI / 6.0, 4.0),
+            "{r:?}"
+        );
+        // No root at all: g keeps its sign, or is monotone with ends of one sign.
+        assert!(roots_of(&SineLevel(1.5), -PI, PI).unwrap().is_empty());
+        let f = Quadratic {
+            a: 2.0,
+            b: 3.0,
+            floor: f64::NEG_INFINITY,
+        };
+        assert!(roots_of(&f, -1.0, 1.0).unwrap().is_empty());
+    }
+
+    /// Where no solution can be, nothing is reported; a root there is not a solution.
+    #[test]
+    fn factor_roots_skips_where_no_solution_is_proved() {
+        let f = Quadratic {
+            a: 0.1,
+            b: 0.6,
+            floor: 0.3,
+        };
+        let r = roots_of(&f, -1.0, 1.0).unwrap();
+        assert_eq!(r.len(), 1, "{r:?}");
+        assert!(close(r[0], 0.6, 4.0), "{r:?}");
+    }
+
+    /// A double root (g = (x - a)^2, or sin x = 1) cannot be proved simple: Err, never a
+    /// guess; and a factor nothing is proved about ends within the piece budget.
+    #[test]
+    fn factor_roots_refuses_what_it_cannot_decide() {
+        let f = Quadratic {
+            a: 0.3,
+            b: 0.3,
+            floor: f64::NEG_INFINITY,
+        };
+        assert!(roots_of(&f, -1.0, 1.0).is_err());
+        assert!(roots_of(&SineLevel(1.0), 0.0, PI).is_err());
+        struct Nothing;
+        impl Factor for Nothing {
+            fn over(&self, _: f64, _: f64) -> Enclosure {
+                Enclosure::Unknown
+            }
+            fn value(&self, _: f64) -> Option<(f64, f64)> {
+                None
+            }
+        }
+        let (mut out, mut budget) = (ArrayVec::new(), MAX_PIECES);
+        assert!(factor_roots(&Nothing, -1.0, 1.0, 0, &mut budget, &mut out).is_err());
+        assert!(out.is_empty());
+        // Bisection stopped at its depth (2^64 pieces would not be examined).
+        assert!(budget >= MAX_PIECES - 2 * MAX_SPLIT_DEPTH, "{budget}");
+        // A spent budget refuses at once.
+        let mut spent = 0;
+        let f = Quadratic {
+            a: 0.3,
+            b: 0.7,
+            floor: f64::NEG_INFINITY,
+        };
+        assert!(factor_roots(&f, -1.0, 1.0, 0, &mut spent, &mut out).is_err());
+    }
+
+    /// Every factor's roots, each with the index of its factor; Err when one factor's is.
+    #[test]
+    fn all_factor_roots_labels_each_root_with_its_factor() {
+        let make = |a: f64, b: f64| Quadratic {
+            a,
+            b,
+            floor: f64::NEG_INFINITY,
+        };
+        let r = all_factor_roots(&[make(0.2, 0.9), make(-0.4, 2.0)], -1.0, 1.0).unwrap();
+        let labels: Vec<usize> = r.iter().map(|&(k, _)| k).collect();
+        assert_eq!(labels, [0, 0, 1], "{r:?}");
+        assert!(close(r[0].1, 0.2, 4.0) && close(r[1].1, 0.9, 4.0) && close(r[2].1, -0.4, 4.0));
+        assert!(all_factor_roots(&[make(0.2, 0.9), make(0.5, 0.5)], -1.0, 1.0).is_err());
+    }
+
+    /// Ambiguous intervals at both ends of the circle become one piece across pi; others are
+    /// kept as they are.
+    #[test]
+    fn pieces_join_the_ends_across_pi() {
+        let joined = pieces(&[[-PI, -3.0], [0.1, 0.2], [3.0, PI]]);
+        assert_eq!(joined.as_slice(), [[0.1, 0.2], [3.0, -3.0 + 2.0 * PI]]);
+        for kept in [
+            vec![[-PI, PI]],
+            vec![[-3.1, -3.0], [3.0, PI]],
+            vec![[-PI, -3.0], [3.0, 3.1]],
+            vec![[-PI, -3.0], [0.1, 0.2]],
+        ] {
+            assert_eq!(pieces(&kept).as_slice(), kept.as_slice());
+        }
+    }
+
+    /// The chart pieces cover [lo, hi] end to end, cut at -pi/2, pi/2 and 3 pi/2 only where
+    /// those lie strictly inside.
+    #[test]
+    fn chart_pieces_cut_at_the_charts_edges() {
+        let cases: [(f64, f64, &[f64]); 5] = [
+            (-0.3, 0.4, &[]),
+            (-3.0, 3.0, &[-FRAC_PI_2, FRAC_PI_2]),
+            (-FRAC_PI_2, FRAC_PI_2, &[]),
+            (3.0, 5.0, &[PI + FRAC_PI_2]),
+            (-2.0, 6.0, &[-FRAC_PI_2, FRAC_PI_2, PI + FRAC_PI_2]),
+        ];
+        for (lo, hi, cuts) in cases {
+            let p = chart_pieces(lo, hi);
+            let ends: Vec<f64> = p.iter().map(|&(_, b)| b).collect();
+            let mut want = cuts.to_vec();
+            want.push(hi);
+            assert_eq!(ends, want, "[{lo}, {hi}]");
+            assert_eq!(p[0].0, lo);
+            assert!(
+                p.windows(2).all(|w| w[0].1 == w[1].0),
+                "[{lo}, {hi}]: {p:?}"
+            );
+        }
+    }
+
+    /// l(x) and its derivative, against the formula and a central difference.
+    #[test]
+    fn lin_is_its_form_and_its_derivative() {
+        let l = Lin::new(0.7, -1.3, 2.1);
+        for k in -12..=12 {
+            let x = 0.27 * f64::from(k);
+            let (s, c) = x.sin_cos();
+            assert!((l.at(s, c) - (0.7 - 1.3 * x.cos() + 2.1 * x.sin())).abs() < 1e-15);
+            let h = 1e-6;
+            let (sp, cp) = (x + h).sin_cos();
+            let (sm, cm) = (x - h).sin_cos();
+            let diff = (l.at(sp, cp) - l.at(sm, cm)) / (2.0 * h);
+            assert!((l.d_at(s, c) - diff).abs() < 1e-8, "x = {x}");
+        }
+    }
+
+    fn value_at(p: &[Tracked], t: f64) -> f64 {
+        p.iter().rev().fold(0.0, |acc, c| acc * t + c.v.to_f64())
+    }
+
+    /// (1 + t^2) l(x) is `quad` at t = tan(x / 2) in the chart at 0 and t = tan((x - pi) / 2)
+    /// in the chart at pi; `mul`, `add` and `scale` are the product, sum and multiple.
+    #[test]
+    fn half_angle_quadratics_and_their_arithmetic() {
+        let l = Lin::new(
+            Tracked::exact(0.7),
+            Tracked::exact(-1.3),
+            Tracked::exact(2.1),
+        );
+        let m = Lin::new(
+            Tracked::exact(-0.2),
+            Tracked::exact(0.5),
+            Tracked::exact(0.9),
+        );
+        for k in -11..=11 {
+            let x = 0.28 * f64::from(k);
+            let (s, c) = x.sin_cos();
+            let lx = 0.7 - 1.3 * c + 2.1 * s;
+            let mx = -0.2 + 0.5 * c + 0.9 * s;
+            for (at_pi, t) in [(false, (0.5 * x).tan()), (true, (0.5 * (x - PI)).tan())] {
+                if t.abs() > 10.0 {
+                    continue;
+                }
+                let w = 1.0 + t * t;
+                let (ql, qm) = (quad(&l, at_pi), quad(&m, at_pi));
+                assert!(
+                    (value_at(&ql, t) - w * lx).abs() < 1e-12 * w * w,
+                    "x {x} {at_pi}"
+                );
+                let prod = mul::<3, 3, 5>(&ql, &qm);
+                assert!((value_at(&prod, t) - w * w * lx * mx).abs() < 1e-11 * w * w * w);
+                let sum = add(&ql, &qm);
+                assert!((value_at(&sum, t) - w * (lx + mx)).abs() < 1e-12 * w * w);
+                let triple = scale(&ql, Tracked::exact(3.0));
+                assert!((value_at(&triple, t) - 3.0 * w * lx).abs() < 1e-12 * w * w);
+            }
+        }
+    }
+
+    /// prod (t - r) for the given roots, in double-double.
+    fn with_roots(roots: &[Tracked]) -> Vec<Tracked> {
+        let mut p = vec![Tracked::exact(1.0)];
+        for &r in roots {
+            let mut next = vec![Tracked::exact(0.0); p.len() + 1];
+            for (i, &c) in p.iter().enumerate() {
+                next[i + 1] = next[i + 1] + c;
+                next[i] = next[i] - c * r;
+            }
+            p = next;
+        }
+        p
+    }
+
+    /// Simple roots, 1e-10 apart among them, each proved once to the last bits; at any scale
+    /// (a power of two: the same bits); none where there are none.
+    #[test]
+    fn poly_roots_proves_simple_roots() {
+        let want = [-0.9, -0.35, 0.1, 0.6, 0.6 + 1e-10, 1.7];
+        let p = with_roots(&want.map(Tracked::exact));
+        let out = poly_roots(&p, -1.0, 2.0).unwrap();
+        assert!(out.undecided.is_empty(), "{out:?}");
+        assert_eq!(out.roots.len(), want.len(), "{out:?}");
+        for (got, want) in out.roots.iter().zip(want) {
+            assert!(close(*got, want, 4.0), "{got} for {want}");
+        }
+        for k in [2f64.powi(600), 2f64.powi(-600)] {
+            let scaled: Vec<Tracked> = p.iter().map(|&c| c * k).collect();
+            let again = poly_roots(&scaled, -1.0, 2.0).unwrap();
+            assert_eq!(again.roots, out.roots, "scaled by {k}");
+        }
+        // Only the roots inside [a, b].
+        let inner = poly_roots(&p, 0.0, 1.0).unwrap();
+        assert_eq!(inner.roots.as_slice(), &out.roots[2..5]);
+        let none = [
+            Tracked::exact(1.0),
+            Tracked::exact(0.0),
+            Tracked::exact(1.0),
+        ];
+        let out = poly_roots(&none, -5.0, 5.0).unwrap();
+        assert!(out.roots.is_empty() && out.undecided.is_empty());
+    }
+
+    /// A double root, and a pair 1e-30 apart (exact in double-double, closer than it can
+    /// separate), are left undecided in one interval narrower than [`SAME_ROOT_WIDTH`] holding
+    /// them; the simple roots are still proved.
+    #[test]
+    fn poly_roots_leaves_what_it_cannot_separate_undecided() {
+        let quarter = Tracked::exact(0.25);
+        let pair = quarter + Tracked::exact(1e-30);
+        for (roots, hidden) in [
+            (vec![quarter, quarter, Tracked::exact(-0.5)], [0.25, 0.25]),
+            (
+                vec![quarter, pair, Tracked::exact(-0.5)],
+                [0.25, 0.25 + 1e-30],
+            ),
+        ] {
+            let out = poly_roots(&with_roots(&roots), -1.0, 1.0).unwrap();
+            assert_eq!(out.roots.len(), 1, "{out:?}");
+            assert!(close(out.roots[0], -0.5, 4.0), "{out:?}");
+            assert_eq!(out.undecided.len(), 1, "{out:?}");
+            let [a, b] = out.undecided[0];
+            assert!(
+                a <= hidden[0] && b >= hidden[1] && b - a <= SAME_ROOT_WIDTH,
+                "{out:?}"
+            );
+            assert!(out.decided_up_to_same_root());
+        }
+        let wide = DdRoots {
+            roots: ArrayVec::new(),
+            undecided: [[0.0, 2.0 * SAME_ROOT_WIDTH]].into_iter().collect(),
+        };
+        assert!(!wide.decided_up_to_same_root());
+    }
+
+    /// prod sin(x - r) over four angles as (1 + t^2)^4 F in either chart: `dd_roots` finds
+    /// every root r + k pi inside [lo, hi] once, as an angle inside it, across the charts'
+    /// edges, with a root next to pi/2 and one next to pi.
+    #[test]
+    fn dd_roots_finds_each_angle_once_across_the_charts() {
+        let r = [-1.2, 0.4, FRAC_PI_2 + 1e-3, PI - 2e-3];
+        let sc: Vec<(f64, f64)> = r.iter().map(|x: &f64| x.sin_cos()).collect();
+        let poly = |at_pi: bool| -> Poly8 {
+            let q: Vec<[Tracked; 3]> = sc
+                .iter()
+                .map(|&(s, c)| {
+                    let l = Lin::new(Tracked::exact(0.0), Tracked::exact(-s), Tracked::exact(c));
+                    quad(&l, at_pi)
+                })
+                .collect();
+            let a = mul::<3, 3, 5>(&q[0], &q[1]);
+            let b = mul::<3, 3, 5>(&q[2], &q[3]);
+            mul::<5, 5, 9>(&a, &b)
+        };
+        for (lo, hi) in [(-PI, PI), (-3.0, 3.0), (0.0, 2.0 * PI), (1.0, 5.0)] {
+            let out = dd_roots(poly, lo, hi).unwrap();
+            assert!(out.undecided.is_empty(), "[{lo}, {hi}]: {out:?}");
+            let mut want: Vec<f64> = sc
+                .iter()
+                .flat_map(|&(s, c)| {
+                    let x = s.atan2(c);
+                    [x - 2.0 * PI, x - PI, x, x + PI, x + 2.0 * PI]
+                })
+                .filter(|&x| x > lo && x < hi)
+                .collect();
+            want.sort_by(f64::total_cmp);
+            let mut got = out.roots.to_vec();
+            got.sort_by(f64::total_cmp);
+            assert_eq!(got.len(), want.len(), "[{lo}, {hi}]: {got:?} for {want:?}");
+            for (g, w) in got.iter().zip(&want) {
+                assert!((g - w).abs() < 4e-15 * (1.0 + w.abs()), "{g} for {w}");
+            }
+        }
+    }
+
+    /// A simple root within a few units of a chart's edge (pi/2, -pi/2, 3 pi/2) lies in both
+    /// pieces' widened ends: reported once (it was twice, 2 units either side of the edge).
+    #[test]
+    fn dd_roots_reports_a_root_at_a_charts_edge_once() {
+        for cut in [-FRAC_PI_2, FRAC_PI_2, PI + FRAC_PI_2] {
+            for k in -24..=24 {
+                let x0 = cut + f64::from(k) * f64::EPSILON * cut.abs();
+                let (s, c) = x0.sin_cos();
+                // sin(x - x0) (2 + 0.3 cos x + 0.1 sin x)^3: one simple root in [cut -+ 0.5].
+                let poly = |at_pi: bool| -> Poly8 {
+                    let root = Lin::new(Tracked::exact(0.0), Tracked::exact(-s), Tracked::exact(c));
+                    let positive = quad(
+                        &Lin::new(
+                            Tracked::exact(2.0),
+                            Tracked::exact(0.3),
+                            Tracked::exact(0.1),
+                        ),
+                        at_pi,
+                    );
+                    let a = mul::<3, 3, 5>(&quad(&root, at_pi), &positive);
+                    let b = mul::<5, 3, 7>(&a, &positive);
+                    mul::<7, 3, 9>(&b, &positive)
+                };
+                let out = dd_roots(poly, cut - 0.5, cut + 0.5).unwrap();
+                assert!(out.undecided.is_empty(), "{cut} {k}: {out:?}");
+                assert_eq!(out.roots.len(), 1, "{cut} {k}: {out:?}");
+                let want = s.atan2(c) + if cut > PI { 2.0 * PI } else { 0.0 };
+                assert!((out.roots[0] - want).abs() < 8e-15, "{cut} {k}: {out:?}");
+                // The root made double: one undecided interval round it, whichever pieces saw it.
+                let double = |at_pi: bool| -> Poly8 {
+                    let root = Lin::new(Tracked::exact(0.0), Tracked::exact(-s), Tracked::exact(c));
+                    let positive = quad(
+                        &Lin::new(
+                            Tracked::exact(2.0),
+                            Tracked::exact(0.3),
+                            Tracked::exact(0.1),
+                        ),
+                        at_pi,
+                    );
+                    let q = quad(&root, at_pi);
+                    let a = mul::<3, 3, 5>(&q, &q);
+                    mul::<5, 5, 9>(&a, &mul::<3, 3, 5>(&positive, &positive))
+                };
+                let out = dd_roots(double, cut - 0.5, cut + 0.5).unwrap();
+                assert!(out.roots.is_empty(), "{cut} {k}: {out:?}");
+                assert_eq!(out.undecided.len(), 1, "{cut} {k}: {out:?}");
+                let [a, b] = out.undecided[0];
+                assert!(a <= want + 8e-15 && b >= want - 8e-15, "{cut} {k}: {out:?}");
+                assert!(out.decided_up_to_same_root(), "{cut} {k}: {out:?}");
+            }
+        }
     }
 
     /// A factor linear in the angle: its root is proved and found.
