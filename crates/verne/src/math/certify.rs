@@ -598,7 +598,7 @@ mod tests {
             }
         }
         fn value(&self, x: f64) -> Option<(f64, f64)> {
-            (x >= self.floor).then(|| ((x - self.a) * (x - self.b), 2.0 * x - self.a - self.b))
+            (x >= self.floor).then_some(((x - self.a) * (x - self.b), 2.0 * x - self.a - self.b))
         }
     }
 
@@ -699,8 +699,12 @@ mod tests {
         let (mut out, mut budget) = (ArrayVec::new(), MAX_PIECES);
         assert!(factor_roots(&Nothing, -1.0, 1.0, 0, &mut budget, &mut out).is_err());
         assert!(out.is_empty());
-        // Bisection stopped at its depth (2^64 pieces would not be examined).
+        // Bisection stopped at its depth (2^64 pieces would not be examined), also next to 0,
+        // where the pieces' width stays above the rounding of their ends all the way down.
         assert!(budget >= MAX_PIECES - 2 * MAX_SPLIT_DEPTH, "{budget}");
+        let mut budget = MAX_PIECES;
+        assert!(factor_roots(&Nothing, 0.0, 1.0, 0, &mut budget, &mut out).is_err());
+        assert_eq!(budget, MAX_PIECES - MAX_SPLIT_DEPTH - 1);
         // A spent budget refuses at once.
         let mut spent = 0;
         let f = Quadratic {

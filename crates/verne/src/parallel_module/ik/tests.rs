@@ -1357,3 +1357,153 @@ fn touching_interval_holds_every_root_the_error_allows() {
     }
     assert!(roots > 1000, "{roots}");
 }
+
+// ------------------------------------------------------------ the fast path's lower branch
+
+/// A leg-I posture at alpha and a point whose legs II and III have the room `arg` (L^2 - dx^2 -
+/// dy^2 of eqs. (12)-(13), mm^2) given for leg `tight` (1 or 2), the other leg 1 mm or more of
+/// room; with the point, that other leg's room.
+fn posture_with_room(m: &Machine, alpha: f64, tight: usize, arg: f64) -> (Vector3<f64>, Leg1) {
+    let g = &m.module;
+    let (sin, cos) = alpha.sin_cos();
+    // dy2 = y - R2 c + r4 and dy3 = y + R2 c - r4: the leg whose |dy| is larger has less room.
+    // dy_tight^2 - dy_other^2 = 4 |y k|: enough for the other leg's 1 mm^2 more and its L.
+    let k = g.r_big2 * cos - g.r4;
+    let (l, l_other) = if tight == 1 {
+        (g.l2, g.l3)
+    } else {
+        (g.l3, g.l2)
+    };
+    let y_mag = (60.0f64).max((l * l - l_other * l_other + 100.0) / (4.0 * k.abs()));
+    let y = if tight == 1 { -k.signum() } else { k.signum() } * y_mag;
+    let dy = if tight == 1 { y - k } else { y + k };
+    let dx = (l * l - dy * dy - arg).sqrt();
+    let p = Vector3::new(dx - g.dx2, y, 1000.0);
+    let leg1 = Leg1 {
+        alpha,
+        rho1: p.z - 0.5 * g.l1,
+        sin,
+        cos,
+    };
+    (p, leg1)
+}
+
+/// The lower branch's close call (a square root of eqs. (12)-(13) within `FAST_MARGIN_MM` of
+/// zero, where the labels of its two roots are for `solve` to give): a leg that reaches within
+/// the rounding allowance (h = 0) or misses by less than the margin is a close call, alone (the
+/// other leg with room); a leg that misses by more, or has 1e-3 mm or more of room, is not.
+#[test]
+fn lower_branch_calls_a_leg_at_its_margin_close() {
+    use super::{FAST_MARGIN_MM, lower_branch};
+    use crate::parallel_module::branches::cos_tilt_max;
+    use crate::tolerance::SQRT_ARG_REL;
+    for m in machines() {
+        let ct = cos_tilt_max(&m);
+        for tight in [1, 2] {
+            let l = if tight == 1 { m.module.l2 } else { m.module.l3 };
+            for (arg, close) in [
+                (-0.25 * SQRT_ARG_REL * l * l, true),
+                (-0.5 * FAST_MARGIN_MM * l, true),
+                (-2.0 * FAST_MARGIN_MM * l, false),
+                (1e-6, false),
+                (1.0, false),
+            ] {
+                for alpha in [0.05, -0.2] {
+                    let (p, leg1) = posture_with_room(&m, alpha, tight, arg);
+                    let g = &m.module;
+                    let other_dy = if tight == 1 {
+                        p.y + g.r_big2 * leg1.cos - g.r4
+                    } else {
+                        p.y - g.r_big2 * leg1.cos + g.r4
+                    };
+                    let dx = p.x + g.dx2;
+                    let other_l = if tight == 1 { g.l3 } else { g.l2 };
+                    assert!(
+                        other_l * other_l - dx * dx - other_dy * other_dy > 1.0,
+                        "{}",
+                        m.name
+                    );
+                    let lower = lower_branch(&m, &p, &leg1, ct);
+                    assert_eq!(
+                        lower.close_call, close,
+                        "{}: leg {tight}, room {arg} mm^2, alpha {alpha}",
+                        m.name
+                    );
+                    // Both legs at once: with L2 = L3 = l and y = 0, dy2 = -dy3, and both
+                    // legs have this room.
+                    let mut twin = m.clone();
+                    (twin.module.l2, twin.module.l3) = (l, l);
+                    let k = g.r_big2 * leg1.cos - g.r4;
+                    let at = Vector3::new((l * l - k * k - arg).sqrt() - g.dx2, 0.0, p.z);
+                    let lower = lower_branch(&twin, &at, &leg1, ct);
+                    assert_eq!(lower.close_call, close, "{}: both legs, room {arg}", m.name);
+                }
+            }
+        }
+    }
+}
+
+/// The lower branch is feasible only with R1 cos(alpha) > r1 (leg I's rods not crossing): on
+/// machines whose rods may tilt any way and whose strokes are unbounded, so that nothing else
+/// refuses it, a posture 1 mm on either side of R1 cos(alpha) = r1 is feasible on one side only
+/// (on the machines as built, the rods' tilt refuses these postures first).
+#[test]
+fn lower_branch_refuses_crossing_rods_of_leg_one() {
+    use super::lower_branch;
+    for mut m in machines() {
+        m.limits.cos_rod_tilt_max = -1.0;
+        m.limits.rho_min = [-1e9; 3];
+        m.limits.rho_max = [1e9; 3];
+        let g = m.module;
+        for side in [1.0, -1.0] {
+            let cos = (g.r_small1 + side) / g.r_big1;
+            for alpha in [cos.acos(), -cos.acos()] {
+                let (p, leg1) = posture_with_room(&m, alpha, 1, 400.0 * 400.0);
+                let lower = lower_branch(&m, &p, &leg1, m.limits.cos_rod_tilt_max);
+                assert!(!lower.close_call, "{}", m.name);
+                assert_eq!(lower.feasible, side > 0.0, "{}: alpha {alpha}", m.name);
+            }
+        }
+    }
+}
+
+/// A leg-I posture is clear of the fast path's margins only when all three hold: R1 cos(alpha)
+/// more than `FAST_MARGIN_MM` above r1, |alpha| more than `FAST_MARGIN_RAD` from 0, and slider
+/// 1 more than `FAST_MARGIN_MM` below the platform (s1 = -1); any one at half its margin, or on
+/// the wrong side, is not clear.
+#[test]
+fn clear_of_margins_needs_all_three() {
+    use super::{FAST_MARGIN_MM, FAST_MARGIN_RAD, clear_of_margins};
+    for m in machines() {
+        let g = &m.module;
+        let p = Vector3::new(-300.0, 10.0, 1000.0);
+        let posture = |alpha: f64, below: f64| {
+            let (sin, cos) = alpha.sin_cos();
+            Leg1 {
+                alpha,
+                rho1: p.z - below,
+                sin,
+                cos,
+            }
+        };
+        // alpha where R1 cos(alpha) - r1 = d.
+        let at = |d: f64| ((g.r_small1 + d) / g.r_big1).acos();
+        for sign in [1.0, -1.0] {
+            assert!(
+                clear_of_margins(g, &p, &posture(sign * at(10.0), 100.0)),
+                "{}",
+                m.name
+            );
+            for (alpha, below) in [
+                (sign * at(0.5 * FAST_MARGIN_MM), 100.0),
+                (sign * at(-10.0), 100.0),
+                (sign * 0.5 * FAST_MARGIN_RAD, 100.0),
+                (sign * at(10.0), 0.5 * FAST_MARGIN_MM),
+                (sign * at(10.0), -1.0),
+            ] {
+                let l = posture(alpha, below);
+                assert!(!clear_of_margins(g, &p, &l), "{}: {l:?}", m.name);
+            }
+        }
+    }
+}
