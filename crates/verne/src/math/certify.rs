@@ -705,6 +705,23 @@ mod tests {
         let mut budget = MAX_PIECES;
         assert!(factor_roots(&Nothing, 0.0, 1.0, 0, &mut budget, &mut out).is_err());
         assert_eq!(budget, MAX_PIECES - MAX_SPLIT_DEPTH - 1);
+        // Undecided only on the right halves (no solution below 0): the same depth limit.
+        struct NothingAbove0;
+        impl Factor for NothingAbove0 {
+            fn over(&self, _: f64, hi: f64) -> Enclosure {
+                if hi < 0.0 {
+                    Enclosure::NoSolution
+                } else {
+                    Enclosure::Unknown
+                }
+            }
+            fn value(&self, _: f64) -> Option<(f64, f64)> {
+                None
+            }
+        }
+        let mut budget = MAX_PIECES;
+        assert!(factor_roots(&NothingAbove0, -1.0, 0.0, 0, &mut budget, &mut out).is_err());
+        assert_eq!(budget, MAX_PIECES - 2 * MAX_SPLIT_DEPTH - 1);
         // A spent budget refuses at once.
         let mut spent = 0;
         let f = Quadratic {
@@ -713,6 +730,151 @@ mod tests {
             floor: f64::NEG_INFINITY,
         };
         assert!(factor_roots(&f, -1.0, 1.0, 0, &mut spent, &mut out).is_err());
+    }
+
+    /// A factor with its enclosures and values counted, and its double-precision values given
+    /// as they are (`Honest`), withheld (`Absent`) or for a root `shift` away (`Misleading`):
+    /// Newton's steps only place the estimate, and only enclosures prove it.
+    struct Counted<F> {
+        f: F,
+        values: Values,
+        enclosures: std::cell::Cell<u32>,
+        values_given: std::cell::Cell<u32>,
+    }
+
+    #[derive(Clone, Copy, Debug)]
+    enum Values {
+        Honest,
+        Absent,
+        Misleading(f64),
+    }
+
+    impl<F: Factor> Factor for Counted<F> {
+        fn over(&self, lo: f64, hi: f64) -> Enclosure {
+            self.enclosures.set(self.enclosures.get() + 1);
+            self.f.over(lo, hi)
+        }
+        fn value(&self, x: f64) -> Option<(f64, f64)> {
+            self.values_given.set(self.values_given.get() + 1);
+            match self.values {
+                Values::Honest => self.f.value(x),
+                Values::Absent => None,
+                Values::Misleading(shift) => self.f.value(x - shift),
+            }
+        }
+    }
+
+    /// k ((x - at) - half): a root at `at` + `half`, with enclosures `fuzz` wider either way
+    /// (what a long formula's interval arithmetic gives).
+    struct Line {
+        k: f64,
+        at: f64,
+        half: f64,
+        fuzz: f64,
+    }
+
+    impl Line {
+        fn new(k: f64, at: f64) -> Line {
+            Line {
+                k,
+                at,
+                half: 0.0,
+                fuzz: 0.0,
+            }
+        }
+    }
+
+    impl Factor for Line {
+        fn over(&self, lo: f64, hi: f64) -> Enclosure {
+            let d = Iv::new(lo, hi) - Iv::point(self.at) - Iv::point(self.half);
+            Enclosure::Values {
+                g: d * Iv::point(self.k) + Iv::new(-self.fuzz, self.fuzz),
+                dg: Iv::point(self.k),
+            }
+        }
+        fn value(&self, x: f64) -> Option<(f64, f64)> {
+            Some((((x - self.at) - self.half) * self.k, self.k))
+        }
+    }
+
+    /// `refine_root` on a bracket of a simple root: with honest values, Newton's estimate,
+    /// settled before its last step, and one proved bracket round it (three enclosures); with
+    /// values withheld or misleading (a root 1e-4 or 1e-12 away), bisection on proved signs.
+    /// Each time the root to the last bits, or to where the enclosures allow a sign: steep,
+    /// shallow and curved factors, brackets wide and narrow, the root off-centre, next to 0,
+    /// or half-way between two doubles (bisection then ends on the two).
+    #[test]
+    fn refine_root_places_and_proves_the_root() {
+        let quadratic = || Quadratic {
+            a: 0.3,
+            b: 0.7,
+            floor: f64::NEG_INFINITY,
+        };
+        let half = 0.5 * (0.3f64.next_up() - 0.3);
+        for values in [
+            Values::Honest,
+            Values::Absent,
+            Values::Misleading(1e-4),
+            Values::Misleading(1e-12),
+        ] {
+            // (root found, true root, how far it may be, enclosures and values used)
+            let mut found = Vec::new();
+            let mut push = |(x, n, v): (f64, u32, u32), root: f64, room: f64| {
+                found.push((x, root, room, n, v));
+            };
+            for (lo, hi) in [(0.0, 1.0), (0.29, 0.31), (0.2999, 0.3000001), (0.1, 0.9)] {
+                for k in [1e6, 1.0, 1e-6, -3.0] {
+                    let sign_lo = if k > 0.0 { -1 } else { 1 };
+                    push(
+                        refined(Line::new(k, 0.3), values, lo, hi, sign_lo),
+                        0.3,
+                        0.0,
+                    );
+                    let between = Line {
+                        half,
+                        ..Line::new(k, 0.3)
+                    };
+                    push(refined(between, values, lo, hi, sign_lo), 0.3 + half, 0.0);
+                }
+                let fuzzy = Line {
+                    fuzz: 1e-12,
+                    ..Line::new(1e-3, 0.3)
+                };
+                push(refined(fuzzy, values, lo, hi, -1), 0.3, 4e-9);
+            }
+            for (lo, hi) in [(0.0, 1e-9), (-1e-9, 1e-9)] {
+                push(
+                    refined(Line::new(1.0, 1e-10), values, lo, hi, -1),
+                    1e-10,
+                    0.0,
+                );
+            }
+            push(refined(quadratic(), values, 0.5, 0.9, -1), 0.7, 0.0);
+            push(refined(SineLevel(0.5), values, 0.0, 1.2, -1), PI / 6.0, 0.0);
+            for (x, root, room, n, v) in found {
+                assert!(
+                    (x - root).abs() <= room + 4.0 * f64::EPSILON * root.abs(),
+                    "{values:?}: {x} for {root}"
+                );
+                if let Values::Honest = values {
+                    assert_eq!(n, 3, "{values:?}: {n} enclosures for {root}");
+                    assert!(v < 8, "{values:?}: {v} Newton steps for {root}");
+                }
+            }
+        }
+    }
+
+    /// `refine_root` of `f` with its values as `values`: the root, and the enclosures and
+    /// values it took.
+    fn refined<F: Factor>(f: F, values: Values, lo: f64, hi: f64, sign_lo: i8) -> (f64, u32, u32) {
+        let f = Counted {
+            f,
+            values,
+            enclosures: std::cell::Cell::new(0),
+            values_given: std::cell::Cell::new(0),
+        };
+        let x = refine_root(&f, lo, hi, sign_lo);
+        (x, f.enclosures.get(), f.values_given.get())
     }
 
     /// Every factor's roots, each with the index of its factor; Err when one factor's is.
