@@ -992,6 +992,35 @@ mod tests {
         }
     }
 
+    /// `horner`'s bound covers its double result's distance from the polynomial's value in
+    /// double-double (summed by powers of t instead, a different rounding): the rounding to
+    /// double included, which is most of it where the value is not small.
+    #[test]
+    fn horner_bounds_its_error_rounding_to_double_included() {
+        let third = Tracked::exact(1.0) * Tracked::exact(1.0 / 3.0);
+        let coefficients: Vec<Tracked> = (0..9)
+            .map(|k| {
+                third * Tracked::exact(0.7f64.powi(k) - 0.45) + Tracked::exact(1e-3 * f64::from(k))
+            })
+            .collect();
+        for k in -40..=40 {
+            let t = 0.0731 * f64::from(k);
+            let (v, e) = horner(&coefficients, t);
+            let mut power = Tracked::exact(1.0);
+            let mut sum = Tracked::exact(0.0);
+            for c in &coefficients {
+                sum = sum + *c * power;
+                power = power * Tracked::exact(t);
+            }
+            let off = (crate::math::dd::Dd::from_f64(v) - sum.v).to_f64().abs();
+            assert!(off <= e, "t = {t}: {v} is {off} off, bound {e}");
+            assert!(
+                e <= 2.0 * f64::EPSILON * v.abs() + sum.error(2 * HALF_ANGLE_OPS),
+                "t = {t}"
+            );
+        }
+    }
+
     /// prod (t - r) for the given roots, in double-double.
     fn with_roots(roots: &[Tracked]) -> Vec<Tracked> {
         let mut p = vec![Tracked::exact(1.0)];
