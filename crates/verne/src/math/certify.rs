@@ -347,7 +347,8 @@ pub(crate) fn dd_roots(poly: impl Fn(bool) -> Poly8, lo: f64, hi: f64) -> Result
         let angle = |t: f64| centre + 2.0 * t.atan();
         let first = out.roots.len();
         for x in found.roots.into_iter().map(angle) {
-            // Both pieces' widened ends hold a root at their cut: it is found twice.
+            // Both pieces' widened ends hold a root at their cut: it is found twice. (Two
+            // roots this close, a few units apart, are one solution: `SAME_ROOT_WIDTH`.)
             if next_to_cut(x, clo) {
                 if let Some(k) = at_cut.iter().position(|&y| next_to_cut(x, y)) {
                     at_cut.swap_remove(k);
