@@ -1360,9 +1360,9 @@ fn touching_interval_holds_every_root_the_error_allows() {
 
 // ------------------------------------------------------------ the fast path's lower branch
 
-/// A leg-I posture at alpha and a point whose legs II and III have the room `arg` (L^2 - dx^2 -
-/// dy^2 of eqs. (12)-(13), mm^2) given for leg `tight` (1 or 2), the other leg 1 mm or more of
-/// room; with the point, that other leg's room.
+/// A point and a leg-I posture at alpha (slider 1 half L1 below the platform) where leg `tight`
+/// (1 or 2) has the room `arg` (L^2 - dx^2 - dy^2 of eq. (12) or (13), mm^2) and the other leg
+/// about 100 mm^2 more (the test checks that it has more than 1 mm^2).
 fn posture_with_room(m: &Machine, alpha: f64, tight: usize, arg: f64) -> (Vector3<f64>, Leg1) {
     let g = &m.module;
     let (sin, cos) = alpha.sin_cos();
