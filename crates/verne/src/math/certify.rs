@@ -1065,9 +1065,9 @@ mod tests {
         assert!(out.roots.is_empty() && out.undecided.is_empty());
     }
 
-    /// A double root, and a pair 1e-30 apart (exact in double-double, closer than it can
-    /// separate), are left undecided in one interval narrower than [`SAME_ROOT_WIDTH`] holding
-    /// them; the simple roots are still proved.
+    /// A double root, a pair 1e-30 apart (exact in double-double, closer than it can
+    /// separate) and a triple root are each left undecided in one interval narrower than
+    /// [`SAME_ROOT_WIDTH`] holding them; the simple roots are still proved.
     #[test]
     fn poly_roots_leaves_what_it_cannot_separate_undecided() {
         let quarter = Tracked::exact(0.25);
@@ -1077,6 +1077,11 @@ mod tests {
             (
                 vec![quarter, pair, Tracked::exact(-0.5)],
                 [0.25, 0.25 + 1e-30],
+            ),
+            // A triple root: flat enough that no split point's sign is proved next to it.
+            (
+                vec![quarter, quarter, quarter, Tracked::exact(-0.5)],
+                [0.25, 0.25],
             ),
         ] {
             let out = poly_roots(&with_roots(&roots), -1.0, 1.0).unwrap();
