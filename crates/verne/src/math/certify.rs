@@ -1022,6 +1022,33 @@ mod tests {
         }
     }
 
+    /// `bound_on` bounds sum (|p_k| + e_k) tmax^k from above, e_k the coefficients' error
+    /// bounds (made large here by cancellation: 1e20 - 1e20 + c), and by little more (1e-11);
+    /// the reference summed in double-double.
+    #[test]
+    fn bound_on_covers_the_coefficients_and_their_errors() {
+        use crate::math::dd::Dd;
+        let big = Tracked::exact(1e20);
+        let p: Vec<Tracked> = [0.3, -1.7, 2.9, 0.0, -0.45, 1.1]
+            .iter()
+            .map(|&c| big - big + Tracked::exact(c))
+            .collect();
+        assert!(p[0].error(HALF_ANGLE_OPS) > 1e-9);
+        for tmax in [0.25, 1.0, 3.0] {
+            let mut reference = Dd::ZERO;
+            for c in p.iter().rev() {
+                reference = reference * Dd::from_f64(tmax)
+                    + c.v.abs()
+                    + Dd::from_f64(c.error(HALF_ANGLE_OPS));
+            }
+            let (bound, exact) = (bound_on(&p, tmax), reference.to_f64());
+            assert!(
+                bound >= exact && bound <= exact * (1.0 + 1e-11),
+                "{bound} {exact}"
+            );
+        }
+    }
+
     /// prod (t - r) for the given roots, in double-double.
     fn with_roots(roots: &[Tracked]) -> Vec<Tracked> {
         let mut p = vec![Tracked::exact(1.0)];
