@@ -325,19 +325,17 @@ impl DdRoots {
 /// `poly(at_pi)` giving (1 + t^2)^d F in the chart at 0 or at pi ([`DdRoots`], angles); Err only
 /// where there are more than the lists hold.
 pub(crate) fn dd_roots(poly: impl Fn(bool) -> Poly8, lo: f64, hi: f64) -> Result<DdRoots, ()> {
-    use std::f64::consts::{FRAC_PI_2, PI};
+    use std::f64::consts::PI;
     let mut charts: [Option<Poly8>; 2] = [None, None];
     let mut out = DdRoots::default();
     // The roots the previous piece found next to the cut it shares with this one.
     let mut at_cut: ArrayVec<f64, 16> = ArrayVec::new();
     for (clo, chi) in chart_pieces(lo, hi) {
-        let mid = 0.5 * (clo + chi);
-        let at_pi = !(-FRAC_PI_2..=FRAC_PI_2).contains(&mid);
-        let centre = match (at_pi, mid < 0.0) {
-            (false, _) => 0.0,
-            (true, true) => -PI,
-            (true, false) => PI,
-        };
+        // The chart centred on the multiple of pi nearest the piece (|t| <= 1 on it): at 0 on
+        // [-pi/2, pi/2], at -pi or pi beyond, at 2 pi past 3 pi/2 (a piece joined across pi).
+        let turns = (0.5 * (clo + chi) / PI).round();
+        let at_pi = turns.rem_euclid(2.0) == 1.0;
+        let centre = turns * PI;
         let p = *charts[usize::from(at_pi)].get_or_insert_with(|| poly(at_pi));
         let t_of = |x: f64| (0.5 * (x - centre)).tan();
         // The chart's ends, widened by a few units: the neighbours of [lo, hi] are proved
@@ -1110,6 +1108,15 @@ mod tests {
                 vec![quarter, quarter, quarter, Tracked::exact(-0.5)],
                 [0.25, 0.25],
             ),
+            // A double root at t = 0, where the pieces' width never falls below the rounding
+            // of their ends: the depth limit ends the bisection.
+            (
+                vec![Tracked::exact(0.0); 2]
+                    .into_iter()
+                    .chain([Tracked::exact(-0.5)])
+                    .collect(),
+                [0.0, 0.0],
+            ),
         ] {
             let out = poly_roots(&with_roots(&roots), -1.0, 1.0).unwrap();
             assert_eq!(out.roots.len(), 1, "{out:?}");
@@ -1122,6 +1129,18 @@ mod tests {
             );
             assert!(out.decided_up_to_same_root());
         }
+        // Two double roots: two undecided intervals, each holding its root.
+        let two = poly_roots(
+            &with_roots(&[quarter, quarter, -quarter, -quarter]),
+            -1.0,
+            1.0,
+        )
+        .unwrap();
+        assert!(two.roots.is_empty(), "{two:?}");
+        assert_eq!(two.undecided.len(), 2, "{two:?}");
+        for ([a, b], x) in two.undecided.iter().zip([-0.25, 0.25]) {
+            assert!(*a <= x && *b >= x && b - a <= SAME_ROOT_WIDTH, "{two:?}");
+        }
         let wide = DdRoots {
             roots: ArrayVec::new(),
             undecided: [[0.0, 2.0 * SAME_ROOT_WIDTH]].into_iter().collect(),
@@ -1129,42 +1148,59 @@ mod tests {
         assert!(!wide.decided_up_to_same_root());
     }
 
-    /// prod sin(x - r) over four angles as (1 + t^2)^4 F in either chart: `dd_roots` finds
-    /// every root r + k pi inside [lo, hi] once, as an angle inside it, across the charts'
-    /// edges, with a root next to pi/2 and one next to pi.
-    #[test]
-    fn dd_roots_finds_each_angle_once_across_the_charts() {
-        let r = [-1.2, 0.4, FRAC_PI_2 + 1e-3, PI - 2e-3];
-        let sc: Vec<(f64, f64)> = r.iter().map(|x: &f64| x.sin_cos()).collect();
-        let poly = |at_pi: bool| -> Poly8 {
-            let q: Vec<[Tracked; 3]> = sc
-                .iter()
-                .map(|&(s, c)| {
-                    let l = Lin::new(Tracked::exact(0.0), Tracked::exact(-s), Tracked::exact(c));
-                    quad(&l, at_pi)
-                })
-                .collect();
+    /// prod sin(x - r) over four angles r as (1 + t^2)^4 F in the chart at 0 or at pi, and F's
+    /// roots r + k pi in (lo, hi), in order.
+    fn sines(r: [f64; 4], lo: f64, hi: f64) -> (impl Fn(bool) -> Poly8, Vec<f64>) {
+        let sc = r.map(f64::sin_cos);
+        let poly = move |at_pi: bool| -> Poly8 {
+            let q = sc.map(|(s, c)| {
+                quad(
+                    &Lin::new(Tracked::exact(0.0), Tracked::exact(-s), Tracked::exact(c)),
+                    at_pi,
+                )
+            });
             let a = mul::<3, 3, 5>(&q[0], &q[1]);
             let b = mul::<3, 3, 5>(&q[2], &q[3]);
             mul::<5, 5, 9>(&a, &b)
         };
+        let mut roots: Vec<f64> = sc
+            .iter()
+            .flat_map(|&(s, c)| {
+                let x = s.atan2(c);
+                [x - 2.0 * PI, x - PI, x, x + PI, x + 2.0 * PI]
+            })
+            .filter(|&x| x > lo && x < hi)
+            .collect();
+        roots.sort_by(f64::total_cmp);
+        (poly, roots)
+    }
+
+    /// `dd_roots` finds every root of prod sin(x - r) inside [lo, hi] once, as an angle inside
+    /// it, across the charts' edges, with a root next to pi/2 and one next to pi; with the
+    /// roots made double, one narrow undecided interval round each, in every piece (not joined
+    /// across the pieces).
+    #[test]
+    fn dd_roots_finds_each_angle_once_across_the_charts() {
         for (lo, hi) in [(-PI, PI), (-3.0, 3.0), (0.0, 2.0 * PI), (1.0, 5.0)] {
+            let (poly, want) = sines([-1.2, 0.4, FRAC_PI_2 + 1e-3, PI - 2e-3], lo, hi);
             let out = dd_roots(poly, lo, hi).unwrap();
             assert!(out.undecided.is_empty(), "[{lo}, {hi}]: {out:?}");
-            let mut want: Vec<f64> = sc
-                .iter()
-                .flat_map(|&(s, c)| {
-                    let x = s.atan2(c);
-                    [x - 2.0 * PI, x - PI, x, x + PI, x + 2.0 * PI]
-                })
-                .filter(|&x| x > lo && x < hi)
-                .collect();
-            want.sort_by(f64::total_cmp);
             let mut got = out.roots.to_vec();
             got.sort_by(f64::total_cmp);
             assert_eq!(got.len(), want.len(), "[{lo}, {hi}]: {got:?} for {want:?}");
             for (g, w) in got.iter().zip(&want) {
                 assert!((g - w).abs() < 4e-15 * (1.0 + w.abs()), "{g} for {w}");
+            }
+            let (poly, mut want) = sines([0.4, 0.4, 2.0, 2.0], lo, hi);
+            want.dedup();
+            let out = dd_roots(poly, lo, hi).unwrap();
+            assert!(out.roots.is_empty(), "[{lo}, {hi}]: {out:?}");
+            assert_eq!(out.undecided.len(), want.len(), "[{lo}, {hi}]: {out:?}");
+            for ([a, b], w) in out.undecided.iter().zip(&want) {
+                assert!(
+                    a - 1e-15 <= *w && b + 1e-15 >= *w && b - a <= SAME_ROOT_WIDTH,
+                    "{out:?}"
+                );
             }
         }
     }
