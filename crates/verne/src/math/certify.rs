@@ -281,8 +281,9 @@ fn bound_on(p: &[Tracked], tmax: f64) -> f64 {
     acc * (1.0 + 1e-12)
 }
 
-/// The pieces of [lo, hi] in each half-angle chart: x in [-pi/2, pi/2] (t = tan(x/2)) and
-/// beyond (t = tan((x -+ pi)/2)).
+/// The pieces of [lo, hi] in each half-angle chart: x in [-pi/2, pi/2] (t = tan(x/2)), beyond
+/// it up to 3 pi/2 (t = tan((x -+ pi)/2)), and past 3 pi/2 (t = tan(x/2) again, centred on
+/// 2 pi).
 fn chart_pieces(lo: f64, hi: f64) -> ArrayVec<(f64, f64), 4> {
     use std::f64::consts::{FRAC_PI_2, PI};
     let mut out = ArrayVec::new();
