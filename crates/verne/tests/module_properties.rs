@@ -210,6 +210,12 @@ fn fk_ik_round_trip_over_joint_grid() {
 
 // ---------------------------------------------------------------- the vertical origin
 
+/// An answer and the same input's answer moved: as many solutions, each pair `close`, and the
+/// same proof status (`same_proof`).
+fn same_moved<T>(x: &[T], y: &[T], same_proof: bool, close: impl Fn(&T, &T) -> bool) -> bool {
+    same_proof && x.len() == y.len() && x.iter().zip(y).all(|(u, v)| close(u, v))
+}
+
 /// The three sliders and the platform's z move along parallel vertical axes, so moving every
 /// slider by s moves every assembly mode by s along z and changes nothing else, and moving P by
 /// s along z moves every slider by s: where the sliders' zero lies does not change the answer.
@@ -249,13 +255,16 @@ fn moving_the_vertical_origin_moves_every_solution_with_it() {
                     let (x, y) = (fk::solve(m, &rho), fk::solve(m, &moved));
                     compared += 1;
                     solutions += x.len();
-                    let same = x.len() == y.len()
-                        && x.certificate.proved() == y.certificate.proved()
-                        && x.iter().zip(y.iter()).all(|(u, v)| {
+                    let same = same_moved(
+                        &x,
+                        &y,
+                        x.certificate.proved() == y.certificate.proved(),
+                        |u, v| {
                             u.config == v.config
                                 && ang(u.pose.alpha, v.pose.alpha) <= 1e-11
                                 && (u.pose.p + Vector3::new(0.0, 0.0, s) - v.pose.p).amax() <= 1e-9
-                        });
+                        },
+                    );
                     if !same {
                         failures.push(format!(
                             "{}: FK of {rho:?} moved by {s}: {x:?} then {y:?}",
@@ -268,13 +277,16 @@ fn moving_the_vertical_origin_moves_every_solution_with_it() {
                     let (x, y) = (ik::solve(m, &p), ik::solve(m, &lifted));
                     compared += 1;
                     solutions += x.len();
-                    let same = x.len() == y.len()
-                        && x.certificate.proved() == y.certificate.proved()
-                        && x.iter().zip(y.iter()).all(|(u, v)| {
+                    let same = same_moved(
+                        &x,
+                        &y,
+                        x.certificate.proved() == y.certificate.proved(),
+                        |u, v| {
                             u.config == v.config
                                 && ang(u.alpha, v.alpha) <= 1e-11
                                 && (u.rho.map(|r| r + s) - v.rho).amax() <= 1e-9
-                        });
+                        },
+                    );
                     if !same {
                         failures.push(format!(
                             "{}: IK of {p:?} moved by {s}: {x:?} then {y:?}",

@@ -1214,18 +1214,20 @@ mod tests {
             for k in -24..=24 {
                 let x0 = cut + f64::from(k) * f64::EPSILON * cut.abs();
                 let (s, c) = x0.sin_cos();
+                // sin(x - x0) and 2 + 0.3 cos x + 0.1 sin x (> 0) as quadratics in the chart.
+                let factors = |at_pi: bool| {
+                    let root = Lin::new(Tracked::exact(0.0), Tracked::exact(-s), Tracked::exact(c));
+                    let positive = Lin::new(
+                        Tracked::exact(2.0),
+                        Tracked::exact(0.3),
+                        Tracked::exact(0.1),
+                    );
+                    (quad(&root, at_pi), quad(&positive, at_pi))
+                };
                 // sin(x - x0) (2 + 0.3 cos x + 0.1 sin x)^3: one simple root in [cut -+ 0.5].
                 let poly = |at_pi: bool| -> Poly8 {
-                    let root = Lin::new(Tracked::exact(0.0), Tracked::exact(-s), Tracked::exact(c));
-                    let positive = quad(
-                        &Lin::new(
-                            Tracked::exact(2.0),
-                            Tracked::exact(0.3),
-                            Tracked::exact(0.1),
-                        ),
-                        at_pi,
-                    );
-                    let a = mul::<3, 3, 5>(&quad(&root, at_pi), &positive);
+                    let (q, positive) = factors(at_pi);
+                    let a = mul::<3, 3, 5>(&q, &positive);
                     let b = mul::<5, 3, 7>(&a, &positive);
                     mul::<7, 3, 9>(&b, &positive)
                 };
@@ -1236,16 +1238,7 @@ mod tests {
                 assert!((out.roots[0] - want).abs() < 8e-15, "{cut} {k}: {out:?}");
                 // The root made double: one undecided interval round it, whichever pieces saw it.
                 let double = |at_pi: bool| -> Poly8 {
-                    let root = Lin::new(Tracked::exact(0.0), Tracked::exact(-s), Tracked::exact(c));
-                    let positive = quad(
-                        &Lin::new(
-                            Tracked::exact(2.0),
-                            Tracked::exact(0.3),
-                            Tracked::exact(0.1),
-                        ),
-                        at_pi,
-                    );
-                    let q = quad(&root, at_pi);
+                    let (q, positive) = factors(at_pi);
                     let a = mul::<3, 3, 5>(&q, &q);
                     mul::<5, 5, 9>(&a, &mul::<3, 3, 5>(&positive, &positive))
                 };
