@@ -1794,6 +1794,35 @@ mod tests {
         }
     }
 
+    /// A double root at the middle of a grid interval, where F is within rounding: the proof
+    /// splits the interval off-centre, at 0.3 or 0.7 of it, never outside it. A root 0.1 of a
+    /// step before the interval (found by the neighbour) is reported once, the double root is
+    /// left in one narrow interval, and the other roots are proved: 30 intervals, 120 forms.
+    #[test]
+    fn a_double_root_at_an_intervals_middle_is_split_inside_it() {
+        use std::f64::consts::PI;
+        let step = PI / 16.0;
+        let mut uniform = crate::math::test_rng::lcg(0x0ffc_e47e_0000_0003);
+        let mut unit = || uniform() * 2.0 - 1.0;
+        for trial in 0..120 {
+            let j = 1 + trial % 30;
+            let (xa, xb) = ((j as f64 - 16.0) * step, (j as f64 - 15.0) * step);
+            let double = 0.5 * (xa + xb);
+            let before = xa - 0.1 * step;
+            let (q1, q2) = (PI * unit(), PI * unit());
+            let far = before + 0.3 + 2.0 * unit().abs();
+            let p = from_pairs(&[(double, double), (before, far), (q1, q2)]);
+            let iso = assert_certified(&p, 0.0, &[double, before, far, q1, q2], 1e-9);
+            assert!(
+                iso.roots.iter().any(|r| (r.x - before).abs() < 1e-9),
+                "{iso:?}"
+            );
+            assert_eq!(iso.ambiguous.len(), 1, "{iso:?}");
+            let [lo, hi] = iso.ambiguous[0];
+            assert!(lo <= double && double <= hi && hi - lo < 1e-3, "{iso:?}");
+        }
+    }
+
     /// The isolation's bounds (`Isolation::with_bounds`) cover every form within the coefficients'
     /// error, and that error reaches them. F is a single harmonic of degree 4, whose derivatives
     /// attain `harmonic_bound`; the exact form is F + e with e = ce cos(k (x - x0)), |e| <= ce

@@ -326,6 +326,44 @@ mod tests {
         }
     }
 
+    /// `residual_mm` is the length error along the rod, |f| / (2 L): a slider of an exact
+    /// solution moved by d changes f of each of its rods by d^2 - 2 d v_z exactly (v its rod
+    /// vector), and the residual is the largest of those over 2 L, to 1e-9 relative. Three
+    /// points, each slider, d from 1e-3 to 10 mm either way.
+    #[test]
+    fn the_residual_is_the_length_error_along_the_rod() {
+        let m = crate::spec::Machine::default_verne();
+        let g = &m.module;
+        for p in [
+            Vector3::new(-300.0, 0.0, 1100.0),
+            Vector3::new(-250.0, 40.0, 1100.0),
+            Vector3::new(-320.0, -40.0, 1120.0),
+        ] {
+            let branches = crate::parallel_module::ik::solve(&m, &p);
+            let b = crate::parallel_module::ik::working(&branches).expect("a working branch");
+            let pose = ModulePose { p, alpha: b.alpha };
+            let v = rod_vectors(g, &pose, &b.rho);
+            let l = rod_lengths(g);
+            // The rods on each slider: leg I's two, then legs II and III.
+            let rods: [&[usize]; 3] = [&[0, 1], &[2], &[3]];
+            for (k, on_slider) in rods.iter().enumerate() {
+                for d in [1e-3, -1e-3, 0.1, -0.1, 1.0, -1.0, 10.0, -10.0] {
+                    let mut rho = b.rho;
+                    rho[k] += d;
+                    let want = on_slider
+                        .iter()
+                        .map(|&i| (d * d - 2.0 * d * v[i].z).abs() / (2.0 * l[i]))
+                        .fold(0.0f64, f64::max);
+                    let got = residual_mm(g, &pose, &rho);
+                    assert!(
+                        (got - want).abs() <= 1e-9 * want,
+                        "slider {k}, {d}: {got} {want}"
+                    );
+                }
+            }
+        }
+    }
+
     /// A pose or sliders with a NaN or an infinity never pass a residual test: the residual is
     /// infinite (it was 0 for a NaN, which `f64::max` passed over), and the polish from such a
     /// start reports an infinite residual, not a solution.
