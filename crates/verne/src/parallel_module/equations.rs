@@ -364,6 +364,91 @@ mod tests {
         }
     }
 
+    /// The polish's residual is `residual_mm`: from an exact solution (its first step is
+    /// below `FINAL_STEP_MM`) it is that of the start, bit for bit; from starts moved by up to
+    /// 1 mm and 0.01 rad it bounds that of the pose returned (to 1e-12 mm of rounding), which
+    /// is the solution.
+    #[test]
+    fn the_polish_reports_the_residual_of_what_it_returns() {
+        let m = crate::spec::Machine::default_verne();
+        let g = &m.module;
+        let mut uniform = crate::math::test_rng::lcg(0x9011_54e5_0000_0002);
+        let mut unit = || uniform() * 2.0 - 1.0;
+        for p in [
+            Vector3::new(-300.0, 0.0, 1100.0),
+            Vector3::new(-250.0, 40.0, 1100.0),
+            Vector3::new(-320.0, -40.0, 1120.0),
+        ] {
+            let branches = crate::parallel_module::ik::solve(&m, &p);
+            let b = crate::parallel_module::ik::working(&branches).expect("a working branch");
+            let exact = ModulePose { p, alpha: b.alpha };
+            let (_, residual) = polish_pose_with_residual(g, exact, &b.rho);
+            assert_eq!(residual, residual_mm(g, &exact, &b.rho));
+            for _ in 0..20 {
+                let start = ModulePose {
+                    p: p + Vector3::new(unit(), unit(), unit()),
+                    alpha: b.alpha + 0.01 * unit(),
+                };
+                let (pose, residual) = polish_pose_with_residual(g, start, &b.rho);
+                let actual = residual_mm(g, &pose, &b.rho);
+                // To rounding: both are near 1e-13 mm there.
+                assert!(
+                    actual <= residual + 1e-12 && residual < 1e-9,
+                    "{actual} {residual}"
+                );
+                assert!((pose.p - p).amax() < 1e-6, "{pose:?}");
+            }
+        }
+    }
+
+    /// `solve4` solves A x = b with partial pivoting: for random A, the same with a zero or a
+    /// 1e-12 first pivot (elimination without row swaps divides by it), and A with rows
+    /// permuted, x comes back to 1e-9 relative; a zero column gives None.
+    #[test]
+    fn solve4_pivots() {
+        let mut uniform = crate::math::test_rng::lcg(0x5017_e400_0000_0004);
+        let mut unit = || uniform() * 2.0 - 1.0;
+        for trial in 0..300 {
+            let mut a = Matrix4::from_fn(|_, _| unit());
+            match trial % 3 {
+                0 => a[(0, 0)] = 0.0,
+                1 => a[(0, 0)] = 1e-12,
+                _ => a.swap_rows(0, 1 + trial % 3),
+            }
+            let x = Vector4::from_fn(|_, _| unit());
+            let got = solve4(a, a * x).expect("a regular matrix");
+            // Within the matrix's conditioning: skip the rare nearly singular draw.
+            let cond = a.norm() * a.try_inverse().map_or(f64::INFINITY, |i| i.norm());
+            if cond < 1e4 {
+                assert!((got - x).amax() <= 1e-9 * x.amax(), "{a} {x} {got}");
+            }
+            let mut singular = a;
+            singular.set_column(trial % 4, &Vector4::zeros());
+            assert_eq!(solve4(singular, a * x), None, "{singular}");
+        }
+    }
+
+    /// `rod_tilts` is each rod vector's angle from +z, atan2(|v_xy|, v_z), whatever its length
+    /// (poses that are not solutions, rods shorter and longer than L): 1e-12 rad.
+    #[test]
+    fn rod_tilts_are_the_angles_from_the_slider_axis() {
+        let g = crate::spec::Machine::default_verne().module;
+        let mut uniform = crate::math::test_rng::lcg(0x7117_5000_0000_0006);
+        let mut unit = || uniform() * 2.0 - 1.0;
+        for _ in 0..500 {
+            let pose = ModulePose {
+                p: Vector3::new(600.0 * unit(), 600.0 * unit(), 1100.0 + 900.0 * unit()),
+                alpha: unit(),
+            };
+            let rho = Sliders::new(600.0 * unit(), 600.0 * unit(), 600.0 * unit());
+            let v = rod_vectors(&g, &pose, &rho);
+            for (tilt, v) in rod_tilts(&g, &pose, &rho).iter().zip(v) {
+                let want = v.xy().norm().atan2(v.z);
+                assert!((tilt - want).abs() <= 1e-12, "{tilt} {want}: {v}");
+            }
+        }
+    }
+
     /// A pose or sliders with a NaN or an infinity never pass a residual test: the residual is
     /// infinite (it was 0 for a NaN, which `f64::max` passed over), and the polish from such a
     /// start reports an infinite residual, not a solution.
