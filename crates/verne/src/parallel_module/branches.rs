@@ -423,6 +423,161 @@ mod tests {
         }
     }
 
+    /// [`LegState::ok`] (built without the verdict) is [`LegState::verdict`] being empty, for
+    /// every leg, signed quantity about `CONFIG_SIGN_MM`, tilt and stroke.
+    #[test]
+    fn leg_ok_is_an_empty_verdict() {
+        for leg in 0..3 {
+            for q in [-1.0, 0.0, 0.5 * CONFIG_SIGN_MM, 2.0 * CONFIG_SIGN_MM, 1.0] {
+                for (tilted, outside_stroke) in [(false, false), (true, false), (false, true)] {
+                    let state = LegState {
+                        leg,
+                        q,
+                        tilted,
+                        outside_stroke,
+                    };
+                    assert_eq!(state.ok(), state.verdict().feasible(), "{state:?}");
+                }
+            }
+        }
+    }
+
+    /// [`Verdict::only_limits`]: infeasible, and every reason a limit (a stroke, a rod tilt,
+    /// theta1's range) or the missing proof, none an inverted leg or crossed rods; over all
+    /// 1,024 verdicts.
+    #[test]
+    fn only_limits_means_limits_alone_fail() {
+        for bits in 0..1u16 << Reason::ALL.len() {
+            let v = Verdict::from_bits(bits);
+            let limits = v.reasons().all(|r| {
+                matches!(
+                    r,
+                    Reason::Rho1Stroke
+                        | Reason::Rho2Stroke
+                        | Reason::Rho3Stroke
+                        | Reason::RodTilt
+                        | Reason::Theta1Range
+                        | Reason::Uncertified
+                )
+            });
+            assert_eq!(v.only_limits(), bits != 0 && limits, "{v}");
+        }
+    }
+
+    /// [`leg_state`] builds the rods that eqs. (3)-(6) do: for random poses and sliders of the
+    /// default machine and four random ones (dx1 and dx2 over 1 mm on some), and tilt limits
+    /// from 10 to 170 degrees, a leg is tilted exactly when one of its rods' `rod_tilts` is
+    /// beyond the limit, and its signed quantity is that of [`config_of`] (rods within 1e-9 rad
+    /// of the limit left out).
+    #[test]
+    fn leg_state_tilts_the_rods_of_the_constraint_equations() {
+        use crate::parallel_module::equations::rod_tilts;
+        use crate::selftest::hard_sets::random_geometries;
+        let mut unit = crate::math::test_rng::lcg(0x1e95_7a7e_0000_0001);
+        let mut machines = vec![Machine::default_verne()];
+        machines.extend(random_geometries(4, 27));
+        let offset = |dx: fn(&Machine) -> f64| machines.iter().any(|m| dx(m).abs() > 1.0);
+        assert!(offset(|m| m.module.dx1) && offset(|m| m.module.dx2));
+        let mut seen = [false; 2];
+        for m in &machines {
+            for _ in 0..2_000 {
+                let pose = ModulePose {
+                    p: nalgebra::Vector3::new(
+                        (unit() - 0.5) * 1200.0,
+                        (unit() - 0.5) * 1200.0,
+                        (unit() - 0.5) * 2400.0,
+                    ),
+                    alpha: (unit() - 0.5) * 6.0,
+                };
+                let rho = Sliders::from_fn(|_, _| (unit() - 0.5) * 2400.0);
+                let tilt_max = (10.0 + 160.0 * unit()).to_radians();
+                let tilts = rod_tilts(&m.module, &pose, &rho);
+                let (s, c) = pose.alpha.sin_cos();
+                let config = config_of(&m.module, &pose, &rho);
+                for (leg, rods) in [&[0usize, 1][..], &[2], &[3]].into_iter().enumerate() {
+                    if rods.iter().any(|&i| (tilts[i] - tilt_max).abs() < 1e-9) {
+                        continue;
+                    }
+                    let state = leg_state(m, leg, &pose.p, s, c, rho[leg], tilt_max.cos());
+                    let want = rods.iter().any(|&i| tilts[i] > tilt_max);
+                    assert_eq!(state.tilted, want, "{}: leg {leg}, {pose:?} {rho}", m.name);
+                    assert_eq!(state.sign(), config[leg], "{}: leg {leg}", m.name);
+                    seen[usize::from(want)] = true;
+                }
+            }
+        }
+        assert_eq!(seen, [true; 2]);
+    }
+
+    /// `rod_too_tilted` (no square root) says what acos(r_z / |r|) > tilt_max says, for limits
+    /// below and above 90 degrees (cos_tilt_max of either sign) and rods pointing up or down:
+    /// 20,000 rods, those within 1e-9 rad of the limit left out.
+    #[test]
+    fn rod_too_tilted_is_the_angle_from_the_axis_beyond_the_limit() {
+        let mut unit = crate::math::test_rng::lcg(0x7117_ed00_0000_0001);
+        let mut both = [false; 2];
+        for _ in 0..20_000 {
+            let r = nalgebra::Vector3::new(unit() - 0.5, unit() - 0.5, unit() - 0.5) * 2000.0;
+            let tilt_max = std::f64::consts::PI * unit();
+            let tilt = (r.z / r.norm()).acos();
+            if (tilt - tilt_max).abs() < 1e-9 {
+                continue;
+            }
+            let got = rod_too_tilted(r.z, r.norm_squared(), tilt_max.cos());
+            assert_eq!(got, tilt > tilt_max, "{r} {tilt} {tilt_max}");
+            both[usize::from(got)] = true;
+        }
+        assert_eq!(both, [true; 2]);
+    }
+
+    /// A slider is outside its stroke only beyond it by more than `LIMIT_SLACK`, on either
+    /// side, for each leg.
+    #[test]
+    fn outside_stroke_allows_the_slack_only() {
+        let m = Machine::default_verne();
+        for leg in 0..3 {
+            let (lo, hi) = (m.limits.rho_min[leg], m.limits.rho_max[leg]);
+            for (rho, out) in [
+                (lo, false),
+                (hi, false),
+                (0.5 * (lo + hi), false),
+                (lo - 0.5 * LIMIT_SLACK, false),
+                (hi + 0.5 * LIMIT_SLACK, false),
+                (lo - 2.0 * LIMIT_SLACK - 1e-9 * lo.abs(), true),
+                (hi + 2.0 * LIMIT_SLACK + 1e-9 * hi.abs(), true),
+            ] {
+                assert_eq!(outside_stroke(&m, leg, rho), out, "leg {leg}, {rho}");
+                assert_eq!(
+                    stroke_verdict(&m, leg, rho).feasible(),
+                    !out,
+                    "leg {leg}, {rho}"
+                );
+            }
+        }
+    }
+
+    /// `listed_in_order` vouches for a pair only when the sort (the angle's `total_cmp`, then
+    /// the key) keeps it in that order: equal angles with keys either way, -0 and +0, angles a
+    /// few ulps apart.
+    #[test]
+    fn listed_in_order_agrees_with_the_sort() {
+        let angles = [-1.0, -0.0, 0.0, 1e-300, 0.5, 0.5 + f64::EPSILON, 3.0];
+        for &a in &angles {
+            for &b in &angles {
+                for (ka, kb) in [(0, 0), (0, 1), (1, 0)] {
+                    let sorted = a.total_cmp(&b).then(ka.cmp(&kb)).is_le();
+                    if listed_in_order((a, ka), (b, kb)) {
+                        assert!(sorted, "{a} {ka} before {b} {kb}");
+                    }
+                    // Only -0 before +0 is left to the sort among pairs it keeps.
+                    if sorted && !(a == b && a.to_bits() != b.to_bits()) {
+                        assert!(listed_in_order((a, ka), (b, kb)), "{a} {ka}, {b} {kb}");
+                    }
+                }
+            }
+        }
+    }
+
     /// [`config_of`] (the signs of rho1 - zp, rho2 - zp + R2 sin(alpha), rho3 - zp - R2
     /// sin(alpha), used by `verify`) agrees with the labels the inverse kinematics gives its
     /// branches, which come from the order of each leg's two roots, not from these signs:
