@@ -1742,6 +1742,14 @@ mod tests {
         exact
     }
 
+    /// The largest |coefficient| of p: the scale `isolate_built` normalises by.
+    fn largest_coefficient(p: &Trig) -> f64 {
+        p.cos
+            .iter()
+            .chain(&p.sin)
+            .fold(0.0f64, |m, a| m.max(a.abs()))
+    }
+
     /// A root 6e-13 to 1e-12 inside an end of a grid interval that holds a double root as well:
     /// that interval goes to its chart, whose range reaches 1e-12 past the interval's ends in t
     /// (the tangent of each end is rounded), while F is beyond rounding at the end (F = -(1 -
@@ -1767,13 +1775,7 @@ mod tests {
                         (simple, simple + PI),
                     ]);
                     // The premise: F beyond rounding at the grid point next to the root.
-                    let f = p.scale(
-                        1.0 / p
-                            .cos
-                            .iter()
-                            .chain(&p.sin)
-                            .fold(0.0f64, |m, a| m.max(a.abs())),
-                    );
+                    let f = p.scale(1.0 / largest_coefficient(&p));
                     let end = if simple < double { j } else { j + 1 };
                     assert!(
                         f.at_grid(end % GRID).abs() > f.eval_error(),
@@ -1848,7 +1850,7 @@ mod tests {
             let scale = p.cos[4].abs().max(p.sin[4].abs());
             let rel = [1e-9, 1e-6, 1e-3, 0.1][trial % 4];
             let iso = Isolation::with_bounds(&p, scale, rel * amp, true);
-            // F = fa cos(4 (x - phase)), normalised, and its error ce, both as `new` sees them.
+            // F = fa cos(4 (x - phase)), normalised, and its error ce, as `with_bounds` sees them.
             let (fa, ce) = (amp / scale, rel * amp / scale);
             for n in 0..=4 {
                 // F^(n) at its crest.
@@ -1897,11 +1899,7 @@ mod tests {
         let mut unit = || uniform() * 2.0 - 1.0;
         for _ in 0..50 {
             let p = random_form(&mut unit);
-            let scale = p
-                .cos
-                .iter()
-                .chain(&p.sin)
-                .fold(0.0f64, |m, a| m.max(a.abs()));
+            let scale = largest_coefficient(&p);
             let iso = Isolation::with_bounds(&p, scale, 1e-3 * scale, true);
             let w = 1e-4 * (1.0 + unit());
             let margins = [
