@@ -516,7 +516,6 @@ mod tests {
     #[test]
     fn module_verdict_is_the_solvers_verdict_with_the_configuration_given() {
         use crate::selftest::hard_sets::random_geometries;
-        use nalgebra::Vector3;
         let mut unit = crate::math::test_rng::lcg(0x0de7_e4d1_0000_0001);
         let mut machines = vec![Machine::default_verne()];
         machines.extend(random_geometries(4, 33));
@@ -527,13 +526,8 @@ mod tests {
         ];
         let (mut feasible, mut reasons) = (0, Verdict::default());
         for m in &machines {
-            for _ in 0..80 {
-                let p = Vector3::new(
-                    (unit() - 0.5) * 800.0,
-                    (unit() - 0.5) * 600.0,
-                    (unit() - 0.5) * 1600.0,
-                );
-                for b in crate::parallel_module::ik::solve(m, &p) {
+            for (p, branches) in solved_points(m, 80, &mut unit) {
+                for b in branches {
                     let pose = ModulePose { p, alpha: b.alpha };
                     let v = module_verdict(m, &pose, &b.rho, b.config);
                     assert_eq!(v, b.verdict, "{}: {p:?} {b:?}", m.name);
@@ -623,6 +617,28 @@ mod tests {
         }
     }
 
+    /// `count` points of a box around the module's workspace, drawn from `unit` (uniform in [0,
+    /// 1)), each with every branch the inverse kinematics finds there.
+    fn solved_points(
+        m: &Machine,
+        count: usize,
+        unit: &mut impl FnMut() -> f64,
+    ) -> Vec<(
+        nalgebra::Vector3<f64>,
+        crate::parallel_module::ik::IkBranches,
+    )> {
+        (0..count)
+            .map(|_| {
+                let p = nalgebra::Vector3::new(
+                    (unit() - 0.5) * 800.0,
+                    (unit() - 0.5) * 600.0,
+                    (unit() - 0.5) * 1600.0,
+                );
+                (p, crate::parallel_module::ik::solve(m, &p))
+            })
+            .collect()
+    }
+
     /// [`config_of`] (the signs of rho1 - zp, rho2 - zp + R2 sin(alpha), rho3 - zp - R2
     /// sin(alpha), used by `verify`) agrees with the labels the inverse kinematics gives its
     /// branches, which come from the order of each leg's two roots, not from these signs:
@@ -633,20 +649,14 @@ mod tests {
     fn config_of_agrees_with_the_inverse_kinematics_labels() {
         use crate::parallel_module::equations::ModulePose;
         use crate::selftest::hard_sets::random_geometries;
-        use nalgebra::Vector3;
         let mut unit = crate::math::test_rng::lcg(0x0c0f_1605);
         let mut machines = vec![Machine::default_verne()];
         machines.extend(random_geometries(4, 15));
         let (mut checked, mut met) = (0, [[false; 2]; 3]);
         for m in &machines {
             let g = &m.module;
-            for _ in 0..400 {
-                let p = Vector3::new(
-                    (unit() - 0.5) * 800.0,
-                    (unit() - 0.5) * 600.0,
-                    (unit() - 0.5) * 1600.0,
-                );
-                for b in crate::parallel_module::ik::solve(m, &p) {
+            for (p, branches) in solved_points(m, 400, &mut unit) {
+                for b in branches {
                     let pose = ModulePose { p, alpha: b.alpha };
                     let s = b.alpha.sin() * g.r_big2;
                     let q = [b.rho.x - p.z, b.rho.y - p.z + s, b.rho.z - p.z - s];

@@ -326,6 +326,23 @@ mod tests {
         }
     }
 
+    /// Three points of the default machine's workspace, each with its working branch: the
+    /// exact solutions the residual's and the polish's tests start from.
+    fn working_solutions(m: &Machine) -> Vec<(ModulePose, crate::parallel_module::ik::IkBranch)> {
+        [
+            Vector3::new(-300.0, 0.0, 1100.0),
+            Vector3::new(-250.0, 40.0, 1100.0),
+            Vector3::new(-320.0, -40.0, 1120.0),
+        ]
+        .into_iter()
+        .map(|p| {
+            let branches = crate::parallel_module::ik::solve(m, &p);
+            let b = *crate::parallel_module::ik::working(&branches).expect("a working branch");
+            (ModulePose { p, alpha: b.alpha }, b)
+        })
+        .collect()
+    }
+
     /// `residual_mm` is the length error along the rod, |f| / (2 L): a slider of an exact
     /// solution moved by d changes f of each of its rods by d^2 - 2 d v_z exactly (v its rod
     /// vector), and the residual is the largest of those over 2 L, to 1e-9 relative. Three
@@ -334,14 +351,7 @@ mod tests {
     fn the_residual_is_the_length_error_along_the_rod() {
         let m = crate::spec::Machine::default_verne();
         let g = &m.module;
-        for p in [
-            Vector3::new(-300.0, 0.0, 1100.0),
-            Vector3::new(-250.0, 40.0, 1100.0),
-            Vector3::new(-320.0, -40.0, 1120.0),
-        ] {
-            let branches = crate::parallel_module::ik::solve(&m, &p);
-            let b = crate::parallel_module::ik::working(&branches).expect("a working branch");
-            let pose = ModulePose { p, alpha: b.alpha };
+        for (pose, b) in working_solutions(&m) {
             let v = rod_vectors(g, &pose, &b.rho);
             let l = rod_lengths(g);
             // The rods on each slider: leg I's two, then legs II and III.
@@ -374,14 +384,8 @@ mod tests {
         let g = &m.module;
         let mut uniform = crate::math::test_rng::lcg(0x9011_54e5_0000_0002);
         let mut unit = || uniform() * 2.0 - 1.0;
-        for p in [
-            Vector3::new(-300.0, 0.0, 1100.0),
-            Vector3::new(-250.0, 40.0, 1100.0),
-            Vector3::new(-320.0, -40.0, 1120.0),
-        ] {
-            let branches = crate::parallel_module::ik::solve(&m, &p);
-            let b = crate::parallel_module::ik::working(&branches).expect("a working branch");
-            let exact = ModulePose { p, alpha: b.alpha };
+        for (exact, b) in working_solutions(&m) {
+            let p = exact.p;
             let (_, residual) = polish_pose_with_residual(g, exact, &b.rho);
             assert_eq!(residual, residual_mm(g, &exact, &b.rho));
             for _ in 0..20 {
