@@ -315,27 +315,39 @@ fn touching_postures(
                     _ => {}
                 }
                 certificate = Certificate::Unproved;
-                let cc = ct.clamp(-1.0, 1.0);
-                let alpha = libm::acos(cc);
-                let h2 = leg1_height_sq(g, p, cc).max(0.0);
-                for rho1 in [p.z + h2.sqrt(), p.z - h2.sqrt()] {
-                    let l = polish_leg1(
-                        g,
-                        p,
-                        Leg1 {
-                            alpha,
-                            rho1,
-                            sin: alpha.sin(),
-                            cos: cc,
-                        },
-                    );
-                    push(l);
-                    push(mirror(p, l));
-                }
+                unproved_touching_postures(g, p, ct, push);
             }
         }
     }
     certificate
+}
+
+/// The last resort for a touching root `ct` of eq. (9) that neither proof decides (no input is
+/// known to reach it): the postures at `ct` itself (clamped to [-1, 1]), with both signs of
+/// eq. (11)'s square root, each polished, and their mirror images.
+fn unproved_touching_postures(
+    g: &ModuleGeometry,
+    p: &Vector3<f64>,
+    ct: f64,
+    push: &mut impl FnMut(Leg1),
+) {
+    let cc = ct.clamp(-1.0, 1.0);
+    let alpha = libm::acos(cc);
+    let h2 = leg1_height_sq(g, p, cc).max(0.0);
+    for rho1 in [p.z + h2.sqrt(), p.z - h2.sqrt()] {
+        let l = polish_leg1(
+            g,
+            p,
+            Leg1 {
+                alpha,
+                rho1,
+                sin: alpha.sin(),
+                cos: cc,
+            },
+        );
+        push(l);
+        push(mirror(p, l));
+    }
 }
 
 /// The interval of cos(alpha) about a critical point `ct` of the cubic (9) `c` (normalised)
@@ -967,9 +979,10 @@ fn working_by_cubic(m: &Machine, p: &Vector3<f64>) -> Option<IkBranch> {
         }
         // eq. (14): rho1 - zp = y (R1 cos a - r1) / (R1 sin a); s1 = -1 takes alpha of the sign
         // opposite to y (R1 cos a - r1). Near zero both signs could be s1 = -1.
+        // h >= FAST_MARGIN_MM already: h2 passed the test above, and sqrt(1e-12) is 1e-6.
         let yw = p.y * (r * c - rr);
         let h = h2.sqrt();
-        if (yw / (r * sin_a)).abs() < FAST_MARGIN_MM || h < FAST_MARGIN_MM {
+        if (yw / (r * sin_a)).abs() < FAST_MARGIN_MM {
             return None;
         }
         let a = c.acos();

@@ -55,6 +55,15 @@ fn machines() -> Vec<Machine> {
     out
 }
 
+/// `m` with its rods free to tilt any way and its strokes unbounded, so that only reach and
+/// the rods of leg I crossing refuse a branch.
+fn with_limits_opened(mut m: Machine) -> Machine {
+    m.limits.cos_rod_tilt_max = -1.0;
+    m.limits.rho_min = [-1e9; 3];
+    m.limits.rho_max = [1e9; 3];
+    m
+}
+
 /// An n x n x n grid over the box the module's workspace lies in, off-centre in each cell (no
 /// point on y = 0, where alpha = 0 is a root and the fast paths hand over).
 fn grid(n: usize) -> impl Iterator<Item = Vector3<f64>> {
@@ -639,6 +648,75 @@ fn leg1_steps_settle_only_at_the_root_and_soon() {
     }
 }
 
+/// Each step settles by its stopping rule, read from what it returns: Newton's exactly when
+/// both predicted errors (`left`) are within [`super::PREDICTED_STEP_FRACTION`] of their stops
+/// (NEWTON_STEP_STOP, and that times 1 + |rho1| in mm), its small-step exit (no prediction,
+/// `left` zero) only on a step below both stops; Chebyshev's whenever its predictions are
+/// within them, otherwise only on a step below both stops. From starts 1e-2 to 1e-14 off the
+/// roots (four to a decade), both unknowns or one alone; each test decides alone somewhere (the
+/// counts asserted).
+#[test]
+fn each_step_settles_by_its_stopping_rule() {
+    use super::PREDICTED_STEP_FRACTION as FRACTION;
+    // Newton: [alpha's prediction alone over, rho1's alone over, the small-step exit];
+    // Chebyshev: [alpha's alone over, rho1's alone over] (on these starts it never settles on
+    // the step alone: its predictions are within the stops first).
+    let (mut newton, mut chebyshev) = ([0usize; 3], [0usize; 2]);
+    for (m, roots) in leg1_roots(8) {
+        for (p, root) in &roots {
+            let eqs = Leg1Equations::new(&m.module, p);
+            for k in 0..=48 {
+                let d = 10f64.powf(-2.0 - 0.25 * f64::from(k));
+                for start in [
+                    moved(root, d, -70.0 * d),
+                    moved(root, d, 0.0),
+                    moved(root, 0.0, -70.0 * d),
+                ] {
+                    let at = format!("{}: {p:?} from {start:?}", m.name);
+                    let (f, dz) = eqs.residuals(&start);
+                    let steps = [
+                        eqs.newton_step(&start, f, dz).expect("a step"),
+                        eqs.corrected_step(&start),
+                    ];
+                    for (k, step) in steps.iter().enumerate() {
+                        let rho_stop = NEWTON_STEP_STOP * (1.0 + step.leg1.rho1.abs());
+                        let over = [
+                            step.left[0] > FRACTION * NEWTON_STEP_STOP,
+                            step.left[1] > FRACTION * rho_stop,
+                        ];
+                        let (da, dr) = off(&step.leg1, &start);
+                        // The step taken, to the rounding of the subtraction that applied it.
+                        let ulps = |x: f64| 4.0 * f64::EPSILON * (1.0 + x.abs());
+                        let small = da <= NEWTON_STEP_STOP + ulps(start.alpha)
+                            && dr <= rho_stop + ulps(start.rho1);
+                        if k == 0 {
+                            assert_eq!(step.settled, over == [false; 2], "Newton: {at}");
+                            if step.left == [0.0; 2] {
+                                assert!(small, "Newton, {da:e} rad, {dr:e} mm: {at}");
+                                newton[2] += 1;
+                            } else if over[0] != over[1] {
+                                newton[usize::from(over[1])] += 1;
+                            }
+                        } else if over != [false; 2] {
+                            assert!(!step.settled || small, "Chebyshev: {at}");
+                            if over[0] != over[1] {
+                                chebyshev[usize::from(over[1])] += 1;
+                            }
+                        } else {
+                            assert!(step.settled, "Chebyshev: {at}");
+                        }
+                    }
+                }
+            }
+        }
+    }
+    eprintln!("Newton {newton:?}, Chebyshev {chebyshev:?}");
+    assert!(
+        newton.iter().chain(&chebyshev).all(|&k| k > 10),
+        "{newton:?} {chebyshev:?}"
+    );
+}
+
 /// On y = 0 from Table II's starts with rho1 alone off by 1e-9 to 10 mm (alpha = 0: eq. (14)
 /// holds for every rho1, and neither step moves alpha, so a step that settled on alpha's step
 /// alone would stop short), both steps say `settled` only within the stopping rule of the
@@ -767,6 +845,65 @@ fn isolated_working_root_certifies_exactly_the_monotone_cubics() {
     }
     eprintln!("decreasing, increasing, not monotone: {kinds:?}");
     assert!(kinds.iter().all(|&k| k > 0), "{kinds:?}");
+}
+
+/// The lanes' certificate decides only with the cubic's derivative beyond its margin at both
+/// ends of [r1/R1, 1] (1e-9 of the largest coefficient, on the same side of zero): points built
+/// with the derivative at one end t times the margin, t = +-0.5 and +-2, and the other end at
+/// least 10 margins away, are certified exactly when |t| > 1 and the two ends agree in sign.
+#[test]
+fn the_lanes_certificate_needs_its_margin_at_both_ends() {
+    use super::{FAST_MARGIN_RAD, MONOTONE_MARGIN, eq9_coefficients, isolated_working_root};
+    let mut unit = crate::math::test_rng::lcg(0x005e_ed0f_ca57);
+    let mut decided = [[0usize; 2]; 2]; // [certified, not] for each end
+    for m in machines() {
+        let g = &m.module;
+        let lo = (g.r_small1 / g.r_big1 - FAST_MARGIN_RAD).max(-1.0);
+        let slope = |p: &Vector3<f64>, x: f64| {
+            let [_, c1, c2, c3] = eq9_coefficients(g, p);
+            (3.0 * c3 * x + 2.0 * c2) * x + c1
+        };
+        let margin_at = |p: &Vector3<f64>| {
+            let c = eq9_coefficients(g, p);
+            MONOTONE_MARGIN * c.iter().fold(0.0f64, |a, b| a.max(b.abs()))
+        };
+        for (end, (x, other)) in [(lo, 1.0), (1.0, lo)].into_iter().enumerate() {
+            let (_, d) = eq9_in_u_and_y(&m, x);
+            for _ in 0..200 {
+                let y2 = (50.0 + 500.0 * unit()).powi(2);
+                for t in [-2.0, -0.5, 0.5, 2.0] {
+                    // F'(x) = d0 + U d1 + Y d2 = t margin, the margin taken at the last point.
+                    let mut p = Vector3::new(0.0, y2.sqrt(), 1000.0);
+                    let mut u2 = -1.0;
+                    for _ in 0..4 {
+                        u2 = (t * margin_at(&p) - d[0] - y2 * d[2]) / d[1];
+                        p.x = u2.max(0.0).sqrt() - g.dx1;
+                    }
+                    let (here, there, margin) = (slope(&p, x), slope(&p, other), margin_at(&p));
+                    let [_, _, c2, c3] = eq9_coefficients(g, &p);
+                    let vertex = -c2 / (3.0 * c3);
+                    if u2 < 0.0 || there.abs() < 10.0 * margin || (vertex > lo && vertex < 1.0) {
+                        continue;
+                    }
+                    assert!(
+                        (here / margin - t).abs() < 1e-3,
+                        "{}: {p:?} {here:e}",
+                        m.name
+                    );
+                    let expected = t.abs() > 1.0 && (t > 0.0) == (there > 0.0);
+                    assert_eq!(
+                        isolated_working_root(&m, &p),
+                        expected,
+                        "{}: {p:?}: slope {t} margins at {x}, {there:e} at {other}",
+                        m.name
+                    );
+                    decided[end][usize::from(!expected)] += 1;
+                }
+            }
+        }
+    }
+    eprintln!("[certified, not] at r1/R1, at 1: {decided:?}");
+    assert!(decided.iter().flatten().all(|&k| k > 50), "{decided:?}");
 }
 
 /// Every leg-I posture of `p` as [`super::solve_into`] finds them, with the certificate.
@@ -906,6 +1043,200 @@ fn postures_at_a_double_root_of_eq9() {
         decided > 100 && extended > 10,
         "{decided} decided, {extended} extended"
     );
+}
+
+/// Two roots of the cubic (9) proved apart but within [`super::FAST_MARGIN_RAD`] of each other in
+/// alpha (a double root above r1/R1 split by moving u 1e-9 to 1e-15, relative), at heights z
+/// from 450 to 1650 mm: `working_by_cubic` hands every such point over (None) where leg I
+/// reaches at both roots, and none has a working branch. So its test of two roots' angles is a
+/// safety net: at a double root F'(c) = 0, and a root with leg I's rods within 90 degrees of
+/// +z has F' > 0 (`at_most_one_root_of_eq9_carries_a_feasible_branch`), so the rods of both
+/// roots lie within about 1e-6 rad of horizontal, beyond every machine's tilt limit.
+#[test]
+fn two_roots_within_the_angle_margin_are_handed_over() {
+    use super::{FAST_MARGIN_MM, FAST_MARGIN_RAD, cubic_eq9, leg1_height_sq};
+    use crate::math::cubic::cubic_roots_in;
+    let (mut close, mut working_open) = (0, 0);
+    let as_built = machines().into_iter().map(|m| (m, false));
+    for (m, open) in as_built.chain(
+        machines()
+            .into_iter()
+            .map(|m| (with_limits_opened(m), true)),
+    ) {
+        let g = &m.module;
+        let lo = (g.r_small1 / g.r_big1 - FAST_MARGIN_RAD).max(-1.0);
+        for (c0, p0) in double_root_points(&m) {
+            let u0 = p0.x + g.dx1;
+            for k in 0..=24 {
+                for side in [1.0, -1.0] {
+                    let rel = side * 10f64.powf(-9.0 - 0.25 * f64::from(k));
+                    let p = Vector3::new(u0 * (1.0 + rel) - g.dx1, p0.y, p0.z);
+                    let Some(coeffs) = cubic_eq9(g, &p) else {
+                        continue;
+                    };
+                    let roots = cubic_roots_in(&coeffs, lo, 1.0);
+                    let near: Vec<_> = roots.iter().filter(|r| (r.x - c0).abs() < 1e-2).collect();
+                    let [a, b] = near[..] else {
+                        continue;
+                    };
+                    let apart = (a.x.acos() - b.x.acos()).abs();
+                    let reach = [a.x, b.x]
+                        .map(|c| leg1_height_sq(g, &p, c) > FAST_MARGIN_MM * FAST_MARGIN_MM);
+                    if a.touching || b.touching || apart >= FAST_MARGIN_RAD || reach != [true; 2] {
+                        continue;
+                    }
+                    assert!(apart > 0.0, "{}: {p:?}", m.name);
+                    // Neither the cubic (9) nor leg I's height depends on z.
+                    for z in (0..=12).map(|i| 450.0 + 100.0 * f64::from(i)) {
+                        let p = Vector3::new(p.x, p.y, z);
+                        let at = format!("{}: c0 {c0:.1}, {rel:e} off: {p:?}: {apart:e}", m.name);
+                        assert_eq!(working_by_cubic(&m, &p), None, "{at}");
+                        let has = working(&solve(&m, &p)).is_some();
+                        assert!(open || !has, "{at}");
+                        working_open += usize::from(has);
+                        close += 1;
+                    }
+                }
+            }
+        }
+    }
+    eprintln!("{close} points, {working_open} with a working branch");
+    assert!(close > 500, "{close}");
+}
+
+/// Eq. (14) gives |rho1 - z_p| = |y (R1 cos(alpha) - r1)| / (R1 |sin(alpha)|) at a root; below
+/// [`super::FAST_MARGIN_MM`] the posture is too close to its mirror image (s1 = +1) for the
+/// fast path's label. Points 1e-7 to 0.1 mm off y = 0 next to where leg I lies flat (either
+/// side, five machines, limits opened so that nothing else refuses them) have a root in
+/// (r1/R1, 1] with that height below the margin, where leg I's height from eq. (11), computed
+/// with the rounding of its cancellation, can still come out above it: `working_by_cubic` hands
+/// every such point over.
+#[test]
+fn a_root_with_rho1_within_the_margin_of_z_is_handed_over() {
+    use super::{FAST_MARGIN_MM, FAST_MARGIN_RAD, cubic_eq9, leg1_height_sq};
+    use crate::math::cubic::cubic_roots_in;
+    let (mut low, mut handed_over_by_it) = (0, 0);
+    for m in machines().into_iter().map(with_limits_opened) {
+        let g = &m.module;
+        let (r, rr) = (g.r_big1, g.r_small1);
+        let lo = (rr / r - FAST_MARGIN_RAD).max(-1.0);
+        // At y = 0, eq. (9) is (c^2 - 1) (2 R1^3 r1 c + R1^2 (k0 - u^2)): the root c = (u^2 -
+        // k0) / (2 R1 r1), where leg I lies flat (eq. (11): rho1 = z_p). Points next to it.
+        let k0 = g.l1 * g.l1 - r * r - rr * rr;
+        // Just above r1/R1, the root near cos(alpha) = 1 (sin(alpha) about y sqrt(r1 / (2 R1 (1 -
+        // c))) / R1 there) clears the angle margin while the height at c stays below its own.
+        let near = [1e-2, 1e-3, 1e-4, 1e-5].map(|d| rr / r + d);
+        let across = (0..20).map(|i| rr / r + (1.0 - rr / r) * (f64::from(i) + 0.5) / 20.0);
+        for (i, c) in near.into_iter().chain(across).enumerate() {
+            let u = (k0 + 2.0 * r * rr * c).sqrt();
+            for k in 0..=24 {
+                for side in [1.0, -1.0] {
+                    let y = side * 10f64.powf(-1.0 - 0.25 * f64::from(k));
+                    let p = Vector3::new(u - g.dx1, y, 500.0 + 40.0 * i as f64);
+                    let Some(coeffs) = cubic_eq9(g, &p) else {
+                        continue;
+                    };
+                    let below = cubic_roots_in(&coeffs, lo, 1.0).iter().any(|root| {
+                        let c = root.x.clamp(-1.0, 1.0);
+                        let sin = ((1.0 - c) * (1.0 + c)).sqrt();
+                        let h2 = leg1_height_sq(g, &p, c);
+                        !root.touching
+                            && sin >= FAST_MARGIN_RAD
+                            && h2 >= FAST_MARGIN_MM * FAST_MARGIN_MM
+                            && (p.y * (r * c - rr) / (r * sin)).abs() < FAST_MARGIN_MM
+                    });
+                    if below {
+                        assert_eq!(working_by_cubic(&m, &p), None, "{}: {p:?}", m.name);
+                        low += 1;
+                        handed_over_by_it += usize::from(working(&solve(&m, &p)).is_some());
+                    }
+                }
+            }
+        }
+    }
+    eprintln!(
+        "{low} points with a root below the margin, {handed_over_by_it} with a working branch"
+    );
+    assert!(
+        low > 100 && handed_over_by_it > 10,
+        "{low}, {handed_over_by_it}"
+    );
+}
+
+/// The last resort for a touching root that neither proof decides gives postures at the root,
+/// each with its mirror image: at double roots of (9) (c0 from -0.9 to 0.9, five machines, z
+/// from 600 to 1400 mm), four postures, the one of the sign of eq. (11) that eq. (14) takes
+/// exact (1e-9 mm, cos(alpha) within 1e-9 of c0); the other sign's start is not a posture at
+/// c0, and its polish at the fold stops up to 1.4e-5 mm off, 1.7e-4 from c0 (measured; 1e-4 mm
+/// and 1e-3 asserted); at cos(alpha) = 1 on y = 0 (Table II: eq. (14) holds for every
+/// rho1 there), given 1 or a rounding beyond it, both signs of eq. (11), (0, z_p +- h); at the
+/// stretched machine's double root there, (0, z_p).
+#[test]
+fn unproved_touching_postures_are_the_postures_at_the_root() {
+    use super::{leg1_height_sq, leg1_residual_mm, unproved_touching_postures};
+    let postures = |m: &Machine, p: &Vector3<f64>, ct: f64| {
+        let mut out = Vec::new();
+        unproved_touching_postures(&m.module, p, ct, &mut |l: Leg1| out.push(l));
+        out
+    };
+    let (mut double, mut table_ii) = (0, 0);
+    for m in machines() {
+        for (c0, p0) in double_root_points(&m) {
+            for z in [600.0, 1000.0, 1400.0] {
+                let p = Vector3::new(p0.x, p0.y, z);
+                let found = postures(&m, &p, c0);
+                let at = format!("{}: c0 {c0:.1}: {p:?}: {found:?}", m.name);
+                assert_eq!(found.len(), 4, "{at}");
+                let residual = |l: &Leg1| leg1_residual_mm(&m.module, &p, l);
+                for l in &found {
+                    assert!(residual(l) <= 1e-4 && (l.cos - c0).abs() <= 1e-3, "{at}");
+                }
+                assert!(
+                    [found[0], found[2]]
+                        .iter()
+                        .any(|l| residual(l) <= 1e-9 && (l.cos - c0).abs() <= 1e-9),
+                    "{at}"
+                );
+                for (l, image) in [(found[0], found[1]), (found[2], found[3])] {
+                    assert_eq!(image.alpha, -l.alpha, "{at}");
+                    assert!((image.rho1 - z + l.rho1 - z).abs() <= 1e-9, "{at}");
+                }
+                double += 1;
+            }
+        }
+        for p in grid(6).map(|p| Vector3::new(p.x, 0.0, p.z)) {
+            let h2 = leg1_height_sq(&m.module, &p, 1.0);
+            if h2 < 1.0 {
+                continue;
+            }
+            for ct in [1.0, 1.0 + 1e-12] {
+                let found = postures(&m, &p, ct);
+                let at = format!("{}: {p:?}, {ct}: {found:?}", m.name);
+                assert_eq!(found.len(), 4, "{at}");
+                for (l, side) in found.iter().zip([1.0, -1.0, -1.0, 1.0]) {
+                    assert!(l.alpha == 0.0, "{at}");
+                    assert!((l.rho1 - p.z - side * h2.sqrt()).abs() <= 1e-9, "{at}");
+                    assert!(leg1_residual_mm(&m.module, &p, l) <= 1e-9, "{at}");
+                }
+                table_ii += 1;
+            }
+        }
+    }
+    assert!(double > 40 && table_ii > 100, "{double}, {table_ii}");
+    let mut m = Machine::default_verne();
+    (m.module.r_big1, m.module.r_small1, m.module.l1) = (400.0, 100.0, 500.0);
+    let m = Machine::from_toml_str(&m.to_toml(), "stretched").expect("a valid machine");
+    let p = Vector3::new(400.0 - m.module.dx1, 0.0, 1000.0);
+    for ct in [1.0, 1.0 + 1e-12] {
+        let found = postures(&m, &p, ct);
+        assert_eq!(found.len(), 4, "{ct}: {found:?}");
+        for l in found {
+            assert!(
+                l.alpha == 0.0 && (l.rho1 - p.z).abs() <= 1e-9,
+                "{ct}: {l:?}"
+            );
+        }
+    }
 }
 
 /// A posture met twice is listed once ([`super::leg1_postures_into`]): the certified posture
@@ -1450,10 +1781,7 @@ fn lower_branch_calls_a_leg_at_its_margin_close() {
 #[test]
 fn lower_branch_refuses_crossing_rods_of_leg_one() {
     use super::lower_branch;
-    for mut m in machines() {
-        m.limits.cos_rod_tilt_max = -1.0;
-        m.limits.rho_min = [-1e9; 3];
-        m.limits.rho_max = [1e9; 3];
+    for m in machines().into_iter().map(with_limits_opened) {
         let g = m.module;
         for side in [1.0, -1.0] {
             let cos = (g.r_small1 + side) / g.r_big1;
