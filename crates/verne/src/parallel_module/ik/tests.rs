@@ -64,6 +64,13 @@ fn with_limits_opened(mut m: Machine) -> Machine {
     m
 }
 
+/// Each of [`machines`] as built and with its limits opened (true).
+fn as_built_and_opened() -> impl Iterator<Item = (Machine, bool)> {
+    machines()
+        .into_iter()
+        .flat_map(|m| [(m.clone(), false), (with_limits_opened(m), true)])
+}
+
 /// An n x n x n grid over the box the module's workspace lies in, off-centre in each cell (no
 /// point on y = 0, where alpha = 0 is a root and the fast paths hand over).
 fn grid(n: usize) -> impl Iterator<Item = Vector3<f64>> {
@@ -107,10 +114,13 @@ fn assert_answered_most(
 /// `working_by_cubic`, the half of `working_fast` for points the certified lanes hand over (on
 /// the default machine only points at its margins, so the other tests barely reach it), called
 /// alone: where it answers it gives the complete solver's working branch, and it answers for
-/// almost every point that has one (not only the margins hand over).
+/// almost every point that has one (not only the margins hand over). On five machines as built
+/// and with their limits opened (rods free to tilt, strokes unbounded). With the sign of eq.
+/// (14) flipped in its start, the machines as built still pass; the opened default machine
+/// then answers for 33,156 of its 34,488 working points (measured), below the 99.9 % asked.
 #[test]
 fn working_by_cubic_alone_gives_the_working_branch() {
-    for m in machines() {
+    for (m, _) in as_built_and_opened() {
         let (mut working_points, mut answered) = (0usize, 0usize);
         for p in grid(36) {
             let full = solve(&m, &p);
@@ -1060,12 +1070,7 @@ fn two_roots_within_the_angle_margin_are_handed_over() {
     use super::{FAST_MARGIN_MM, FAST_MARGIN_RAD, cubic_eq9, leg1_height_sq};
     use crate::math::cubic::cubic_roots_in;
     let (mut close, mut working_open) = (0, 0);
-    let as_built = machines().into_iter().map(|m| (m, false));
-    for (m, open) in as_built.chain(
-        machines()
-            .into_iter()
-            .map(|m| (with_limits_opened(m), true)),
-    ) {
+    for (m, open) in as_built_and_opened() {
         let g = &m.module;
         let lo = (g.r_small1 / g.r_big1 - FAST_MARGIN_RAD).max(-1.0);
         for (c0, p0) in double_root_points(&m) {
