@@ -1112,6 +1112,79 @@ fn two_roots_within_the_angle_margin_are_handed_over() {
     assert!(close > 500 && working_open > 10, "{close}, {working_open}");
 }
 
+/// A root of the cubic (9) that touches zero within its error (a double root of (9), at
+/// rounding and 1e-14 or 1e-12 off, relative, in u; z from 450 to 1650 mm) is a close call
+/// for the fast path: `working_by_cubic` hands every such point over, on the machines as built
+/// and with their limits opened (where some have a working branch).
+#[test]
+fn a_touching_root_is_handed_over() {
+    use super::{FAST_MARGIN_RAD, cubic_eq9};
+    use crate::math::cubic::cubic_roots_in;
+    let (mut touching, mut with_working) = (0, 0);
+    for (m, _) in as_built_and_opened() {
+        let g = &m.module;
+        let lo = (g.r_small1 / g.r_big1 - FAST_MARGIN_RAD).max(-1.0);
+        for (c0, p0) in double_root_points(&m) {
+            let u0 = p0.x + g.dx1;
+            for rel in [0.0, 1e-14, -1e-14, 1e-12, -1e-12] {
+                let p = Vector3::new(u0 * (1.0 + rel) - g.dx1, p0.y, p0.z);
+                let Some(coeffs) = cubic_eq9(g, &p) else {
+                    continue;
+                };
+                let roots = cubic_roots_in(&coeffs, lo, 1.0);
+                if !roots.iter().any(|r| r.touching && (r.x - c0).abs() < 1e-6) {
+                    continue;
+                }
+                for z in (0..=6).map(|i| 450.0 + 200.0 * f64::from(i)) {
+                    let p = Vector3::new(p.x, p.y, z);
+                    assert_eq!(working_by_cubic(&m, &p), None, "{}: {p:?}", m.name);
+                    touching += 1;
+                    with_working += usize::from(working(&solve(&m, &p)).is_some());
+                }
+            }
+        }
+    }
+    eprintln!("{touching} points with a touching root, {with_working} with a working branch");
+    assert!(touching > 100, "{touching}");
+}
+
+/// Next to y = 0 the cubic (9) has a root next to cos(alpha) = 1, where the two postures of the
+/// root (alpha and -alpha) meet: within [`super::FAST_MARGIN_RAD`] of alpha = 0 the fast path's
+/// label is a close call. Points 1e-10 to 1e-7 mm off y = 0 (an 8^3 grid otherwise, either side,
+/// five machines as built and opened) with such a root in range are all handed over.
+#[test]
+fn a_root_within_the_angle_margin_of_zero_is_handed_over() {
+    use super::{FAST_MARGIN_RAD, cubic_eq9};
+    use crate::math::cubic::cubic_roots_in;
+    let (mut near_zero, mut with_working) = (0, 0);
+    for (m, _) in as_built_and_opened() {
+        let g = &m.module;
+        let lo = (g.r_small1 / g.r_big1 - FAST_MARGIN_RAD).max(-1.0);
+        for p0 in grid(8) {
+            for y in [1e-7, -1e-8, 1e-9, -1e-10] {
+                let p = Vector3::new(p0.x, y, p0.z);
+                let Some(coeffs) = cubic_eq9(g, &p) else {
+                    continue;
+                };
+                let at_zero = cubic_roots_in(&coeffs, lo, 1.0).iter().any(|r| {
+                    let c = r.x.clamp(-1.0, 1.0);
+                    ((1.0 - c) * (1.0 + c)).sqrt() < FAST_MARGIN_RAD
+                });
+                if at_zero {
+                    assert_eq!(working_by_cubic(&m, &p), None, "{}: {p:?}", m.name);
+                    near_zero += 1;
+                    with_working += usize::from(working(&solve(&m, &p)).is_some());
+                }
+            }
+        }
+    }
+    eprintln!("{near_zero} points with a root at alpha = 0, {with_working} with a working branch");
+    assert!(
+        near_zero > 500 && with_working > 100,
+        "{near_zero}, {with_working}"
+    );
+}
+
 /// Eq. (14) gives |rho1 - z_p| = |y (R1 cos(alpha) - r1)| / (R1 |sin(alpha)|) at a root; below
 /// [`super::FAST_MARGIN_MM`] the posture is too close to its mirror image (s1 = +1) for the
 /// fast path's label. Points 1e-7 to 0.1 mm off y = 0 next to where leg I lies flat (either
