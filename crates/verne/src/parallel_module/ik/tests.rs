@@ -56,7 +56,8 @@ fn machines() -> Vec<Machine> {
 }
 
 /// `m` with its rods free to tilt any way and its strokes unbounded, so that only reach and
-/// the rods of leg I crossing refuse a branch.
+/// the rods of leg I crossing refuse a branch (a machine file cannot say this: its rod tilt is
+/// at most 90 degrees; a `Machine` built in code can).
 fn with_limits_opened(mut m: Machine) -> Machine {
     m.limits.cos_rod_tilt_max = -1.0;
     m.limits.rho_min = [-1e9; 3];
