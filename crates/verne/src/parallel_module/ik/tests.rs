@@ -1058,6 +1058,17 @@ fn postures_at_a_double_root_of_eq9() {
     );
 }
 
+/// The roots of the cubic (9) of `p` that `working_by_cubic` searches, in [r1/R1 - its angle
+/// margin, 1]; None where it has no cubic.
+fn roots_searched_by_cubic(
+    m: &Machine,
+    p: &Vector3<f64>,
+) -> Option<crate::math::cubic::CubicRoots> {
+    let g = &m.module;
+    let lo = (g.r_small1 / g.r_big1 - super::FAST_MARGIN_RAD).max(-1.0);
+    super::cubic_eq9(g, p).map(|c| crate::math::cubic::cubic_roots_in(&c, lo, 1.0))
+}
+
 /// Two roots of the cubic (9) proved apart but within [`super::FAST_MARGIN_RAD`] of each other in
 /// alpha (a double root above r1/R1 split by moving u 1e-9 to 1e-15, relative), at heights z
 /// from 450 to 1650 mm: `working_by_cubic` hands every such point over (None) where leg I
@@ -1068,22 +1079,19 @@ fn postures_at_a_double_root_of_eq9() {
 /// strokes unbounded) some have one, and are handed over all the same.
 #[test]
 fn two_roots_within_the_angle_margin_are_handed_over() {
-    use super::{FAST_MARGIN_MM, FAST_MARGIN_RAD, cubic_eq9, leg1_height_sq};
-    use crate::math::cubic::cubic_roots_in;
+    use super::{FAST_MARGIN_MM, FAST_MARGIN_RAD, leg1_height_sq};
     let (mut close, mut working_open) = (0, 0);
     for (m, open) in as_built_and_opened() {
         let g = &m.module;
-        let lo = (g.r_small1 / g.r_big1 - FAST_MARGIN_RAD).max(-1.0);
         for (c0, p0) in double_root_points(&m) {
             let u0 = p0.x + g.dx1;
             for k in 0..=24 {
                 for side in [1.0, -1.0] {
                     let rel = side * 10f64.powf(-9.0 - 0.25 * f64::from(k));
                     let p = Vector3::new(u0 * (1.0 + rel) - g.dx1, p0.y, p0.z);
-                    let Some(coeffs) = cubic_eq9(g, &p) else {
+                    let Some(roots) = roots_searched_by_cubic(&m, &p) else {
                         continue;
                     };
-                    let roots = cubic_roots_in(&coeffs, lo, 1.0);
                     let near: Vec<_> = roots.iter().filter(|r| (r.x - c0).abs() < 1e-2).collect();
                     let [a, b] = near[..] else {
                         continue;
@@ -1119,20 +1127,16 @@ fn two_roots_within_the_angle_margin_are_handed_over() {
 /// and with their limits opened (where some have a working branch).
 #[test]
 fn a_touching_root_is_handed_over() {
-    use super::{FAST_MARGIN_RAD, cubic_eq9};
-    use crate::math::cubic::cubic_roots_in;
     let (mut touching, mut with_working) = (0, 0);
     for (m, _) in as_built_and_opened() {
         let g = &m.module;
-        let lo = (g.r_small1 / g.r_big1 - FAST_MARGIN_RAD).max(-1.0);
         for (c0, p0) in double_root_points(&m) {
             let u0 = p0.x + g.dx1;
             for rel in [0.0, 1e-14, -1e-14, 1e-12, -1e-12] {
                 let p = Vector3::new(u0 * (1.0 + rel) - g.dx1, p0.y, p0.z);
-                let Some(coeffs) = cubic_eq9(g, &p) else {
+                let Some(roots) = roots_searched_by_cubic(&m, &p) else {
                     continue;
                 };
-                let roots = cubic_roots_in(&coeffs, lo, 1.0);
                 if !roots.iter().any(|r| r.touching && (r.x - c0).abs() < 1e-6) {
                     continue;
                 }
@@ -1155,19 +1159,16 @@ fn a_touching_root_is_handed_over() {
 /// five machines as built and opened) with such a root in range are all handed over.
 #[test]
 fn a_root_within_the_angle_margin_of_zero_is_handed_over() {
-    use super::{FAST_MARGIN_RAD, cubic_eq9};
-    use crate::math::cubic::cubic_roots_in;
+    use super::FAST_MARGIN_RAD;
     let (mut near_zero, mut with_working) = (0, 0);
     for (m, _) in as_built_and_opened() {
-        let g = &m.module;
-        let lo = (g.r_small1 / g.r_big1 - FAST_MARGIN_RAD).max(-1.0);
         for p0 in grid(8) {
             for y in [1e-7, -1e-8, 1e-9, -1e-10] {
                 let p = Vector3::new(p0.x, y, p0.z);
-                let Some(coeffs) = cubic_eq9(g, &p) else {
+                let Some(roots) = roots_searched_by_cubic(&m, &p) else {
                     continue;
                 };
-                let at_zero = cubic_roots_in(&coeffs, lo, 1.0).iter().any(|r| {
+                let at_zero = roots.iter().any(|r| {
                     let c = r.x.clamp(-1.0, 1.0);
                     ((1.0 - c) * (1.0 + c)).sqrt() < FAST_MARGIN_RAD
                 });
@@ -1195,13 +1196,11 @@ fn a_root_within_the_angle_margin_of_zero_is_handed_over() {
 /// every such point over.
 #[test]
 fn a_root_with_rho1_within_the_margin_of_z_is_handed_over() {
-    use super::{FAST_MARGIN_MM, FAST_MARGIN_RAD, cubic_eq9, leg1_height_sq};
-    use crate::math::cubic::cubic_roots_in;
+    use super::{FAST_MARGIN_MM, FAST_MARGIN_RAD, leg1_height_sq};
     let (mut low, mut with_working) = (0, 0);
     for m in machines().into_iter().map(with_limits_opened) {
         let g = &m.module;
         let (r, rr) = (g.r_big1, g.r_small1);
-        let lo = (rr / r - FAST_MARGIN_RAD).max(-1.0);
         // At y = 0, eq. (9) is (c^2 - 1) (2 R1^3 r1 c + R1^2 (k0 - u^2)): the root c = (u^2 -
         // k0) / (2 R1 r1), where leg I lies flat (eq. (11): rho1 = z_p). Points next to it.
         let k0 = g.l1 * g.l1 - r * r - rr * rr;
@@ -1215,10 +1214,10 @@ fn a_root_with_rho1_within_the_margin_of_z_is_handed_over() {
                 for side in [1.0, -1.0] {
                     let y = side * 10f64.powf(-1.0 - 0.25 * f64::from(k));
                     let p = Vector3::new(u - g.dx1, y, 500.0 + 40.0 * i as f64);
-                    let Some(coeffs) = cubic_eq9(g, &p) else {
+                    let Some(roots) = roots_searched_by_cubic(&m, &p) else {
                         continue;
                     };
-                    let below = cubic_roots_in(&coeffs, lo, 1.0).iter().any(|root| {
+                    let below = roots.iter().any(|root| {
                         let c = root.x.clamp(-1.0, 1.0);
                         let sin = ((1.0 - c) * (1.0 + c)).sqrt();
                         let h2 = leg1_height_sq(g, &p, c);
