@@ -322,6 +322,47 @@ impl DdRoots {
     }
 }
 
+/// What a piece's isolation in double-double proves ([`dd_verdict`]).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum DdVerdict {
+    /// Every root found is proved, and each undecided interval is narrower than
+    /// [`SAME_ROOT_WIDTH`]: it holds at most one solution, which a candidate at its middle finds
+    /// if it is real (each interval with its middle).
+    Decided {
+        roots: ArrayVec<f64, 16>,
+        undecided: ArrayVec<([f64; 2], f64), 8>,
+    },
+    /// Nothing is proved on the piece (an undecided interval too wide, or more roots than the
+    /// lists hold): best-effort candidates only, the roots found, then the middles of the
+    /// undecided intervals and of the piece.
+    Unproved {
+        roots: ArrayVec<f64, 16>,
+        middles: ArrayVec<f64, 9>,
+    },
+}
+
+/// Sorts what [`dd_roots`] found on the piece [lo, hi] into what it proves ([`DdVerdict`]):
+/// the one decision both proofs by double-double make.
+pub(crate) fn dd_verdict(found: Result<DdRoots, ()>, lo: f64, hi: f64) -> DdVerdict {
+    let middle = |[a, b]: [f64; 2]| 0.5 * (a + b);
+    match found {
+        Ok(found) if found.decided_up_to_same_root() => DdVerdict::Decided {
+            undecided: found.undecided.iter().map(|&ab| (ab, middle(ab))).collect(),
+            roots: found.roots,
+        },
+        other => {
+            let found = other.unwrap_or_default();
+            let mut middles: ArrayVec<f64, 9> =
+                found.undecided.iter().map(|&ab| middle(ab)).collect();
+            middles.push(middle([lo, hi]));
+            DdVerdict::Unproved {
+                roots: found.roots,
+                middles,
+            }
+        }
+    }
+}
+
 /// Every root of F in [lo, hi] (angles, rad) from its half-angle polynomial in double-double,
 /// `poly(at_pi)` giving (1 + t^2)^d F in the chart at 0 or at pi ([`DdRoots`], angles); Err only
 /// where there are more than the lists hold.
@@ -1249,6 +1290,84 @@ mod tests {
                 assert!(a <= want + 8e-15 && b >= want - 8e-15, "{cut} {k}: {out:?}");
                 assert!(out.decided_up_to_same_root(), "{cut} {k}: {out:?}");
             }
+        }
+    }
+
+    /// `dd_verdict` proves what double-double decided up to one solution per narrow interval,
+    /// with each interval's exact middle, and where it did not (an interval wider than
+    /// [`SAME_ROOT_WIDTH`], or `Err`), proves nothing and gives every candidate: the roots, the
+    /// middles of the intervals, then the piece's. The ends are chosen so that the middles are
+    /// exact (dyadic) and any other operation gives another number. Both solvers' best-effort branches
+    /// are reached only here: no input is known for which double-double leaves a wide
+    /// interval.
+    #[test]
+    fn dd_verdict_sorts_what_double_double_proves() {
+        // Dyadic ends: every middle below is exact.
+        let (narrow, narrow_middle) = ([0.25, 0.25 + 2f64.powi(-32)], 0.25 + 2f64.powi(-33));
+        let (wide, wide_middle) = ([0.5, 0.5 + 2f64.powi(-20)], 0.5 + 2f64.powi(-21));
+        assert!(narrow[1] - narrow[0] < SAME_ROOT_WIDTH && wide[1] - wide[0] > SAME_ROOT_WIDTH);
+        let found = |undecided: &[[f64; 2]]| DdRoots {
+            roots: [0.125, 0.75].into_iter().collect(),
+            undecided: undecided.iter().copied().collect(),
+        };
+        let (lo, hi) = (0.0625, 1.0);
+        assert_eq!(
+            dd_verdict(Ok(found(&[narrow])), lo, hi),
+            DdVerdict::Decided {
+                roots: [0.125, 0.75].into_iter().collect(),
+                undecided: [(narrow, narrow_middle)].into_iter().collect(),
+            }
+        );
+        assert_eq!(
+            dd_verdict(Ok(found(&[])), lo, hi),
+            DdVerdict::Decided {
+                roots: [0.125, 0.75].into_iter().collect(),
+                undecided: ArrayVec::new(),
+            }
+        );
+        assert_eq!(
+            dd_verdict(Ok(found(&[narrow, wide])), lo, hi),
+            DdVerdict::Unproved {
+                roots: [0.125, 0.75].into_iter().collect(),
+                middles: [narrow_middle, wide_middle, 0.53125].into_iter().collect(),
+            }
+        );
+        assert_eq!(
+            dd_verdict(Err(()), lo, hi),
+            DdVerdict::Unproved {
+                roots: ArrayVec::new(),
+                middles: [0.53125].into_iter().collect(),
+            }
+        );
+        // On dd_roots' own answer for a double root at 0.3 (sin(x - 0.3)^2 (2 + cos x)^2): one
+        // narrow interval, its middle within it.
+        let (s, c) = 0.3f64.sin_cos();
+        let double = |at_pi: bool| -> Poly8 {
+            let q = quad(
+                &Lin::new(Tracked::exact(0.0), Tracked::exact(-s), Tracked::exact(c)),
+                at_pi,
+            );
+            let positive = quad(
+                &Lin::new(
+                    Tracked::exact(2.0),
+                    Tracked::exact(1.0),
+                    Tracked::exact(0.0),
+                ),
+                at_pi,
+            );
+            mul::<5, 5, 9>(
+                &mul::<3, 3, 5>(&q, &q),
+                &mul::<3, 3, 5>(&positive, &positive),
+            )
+        };
+        match dd_verdict(dd_roots(double, 0.0, 1.0), 0.0, 1.0) {
+            DdVerdict::Decided { roots, undecided } => {
+                assert!(roots.is_empty(), "{roots:?}");
+                assert_eq!(undecided.len(), 1, "{undecided:?}");
+                let ([a, b], m) = undecided[0];
+                assert!(a <= 0.3 && 0.3 <= b && a < m && m < b, "{undecided:?}");
+            }
+            other => panic!("{other:?}"),
         }
     }
 

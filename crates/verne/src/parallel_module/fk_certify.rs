@@ -32,7 +32,7 @@ use arrayvec::ArrayVec;
 use nalgebra::Vector3;
 
 pub(crate) use crate::math::certify::Resolution;
-use crate::math::certify::{self, Enclosure, Factor, Lin, Poly8};
+use crate::math::certify::{self, DdVerdict, Enclosure, Factor, Lin, Poly8};
 use crate::math::dd::Tracked;
 use crate::math::interval::Iv;
 use crate::math::scalar::{Mag, Scalar};
@@ -326,31 +326,28 @@ pub(crate) fn resolve(
             }
             pose.is_some()
         };
-        match found {
-            Ok(found) if found.decided_up_to_same_root() => {
+        match certify::dd_verdict(found, lo, hi) {
+            DdVerdict::Decided {
+                roots,
+                undecided: narrow,
+            } => {
                 worst = worst.max(Resolution::Extended);
                 // A proved root without its start would be a mode dropped: never silently.
-                let built = found.roots.iter().filter(|&&x| push(starts, x)).count();
-                if built < found.roots.len() {
+                let built = roots.iter().filter(|&&x| push(starts, x)).count();
+                if built < roots.len() {
                     worst = Resolution::Unproved;
                 }
-                for [a, b] in found.undecided {
-                    push(allowed, 0.5 * (a + b));
-                    let _ = undecided.try_push([a, b]);
+                for (interval, middle) in narrow {
+                    push(allowed, middle);
+                    let _ = undecided.try_push(interval);
                 }
             }
-            other => {
-                // Best effort where nothing is proved: what was found, and the midpoints.
+            DdVerdict::Unproved { roots, middles } => {
+                // Best effort where nothing is proved: what was found, and the middles.
                 worst = Resolution::Unproved;
-                if let Ok(found) = other {
-                    for &x in &found.roots {
-                        push(fallback, x);
-                    }
-                    for [a, b] in found.undecided {
-                        push(fallback, 0.5 * (a + b));
-                    }
+                for &x in roots.iter().chain(&middles) {
+                    push(fallback, x);
                 }
-                push(fallback, 0.5 * (lo + hi));
             }
         }
     }

@@ -20,7 +20,7 @@
 use arrayvec::ArrayVec;
 use nalgebra::Vector3;
 
-use crate::math::certify::{self, Enclosure, Factor, Lin, Poly8, Resolution};
+use crate::math::certify::{self, DdVerdict, Enclosure, Factor, Lin, Poly8, Resolution};
 use crate::math::dd::Tracked;
 use crate::math::interval::Iv;
 use crate::math::scalar::{Mag, Scalar};
@@ -265,24 +265,21 @@ pub(crate) fn resolve(
                 let _ = to.try_push((x, rho1));
             }
         };
-        match found {
-            Ok(found) if found.decided_up_to_same_root() => {
+        match certify::dd_verdict(found, lo, hi) {
+            DdVerdict::Decided { roots, undecided } => {
                 worst = worst.max(Resolution::Extended);
-                found.roots.iter().for_each(|&x| push(proved, x));
+                roots.iter().for_each(|&x| push(proved, x));
                 // At most one posture per sign of rho1 - zp in each: both tried.
-                for [a, b] in found.undecided {
-                    both_signs(&ff, 0.5 * (a + b), allowed);
+                for (_, middle) in undecided {
+                    both_signs(&ff, middle, allowed);
                 }
             }
-            other => {
+            DdVerdict::Unproved { roots, middles } => {
                 worst = Resolution::Unproved;
-                if let Ok(found) = other {
-                    found.roots.iter().for_each(|&x| push(fallback, x));
-                    for [a, b] in found.undecided {
-                        both_signs(&ff, 0.5 * (a + b), fallback);
-                    }
+                roots.iter().for_each(|&x| push(fallback, x));
+                for x in middles {
+                    both_signs(&ff, x, fallback);
                 }
-                both_signs(&ff, 0.5 * (lo + hi), fallback);
             }
         }
     }
