@@ -259,6 +259,17 @@ fn alpha_zero_seeds(
     seeds
 }
 
+/// A posture already found is `q` again: theta1 within [`SAME_SOLUTION_RAD`] (either side of
+/// pi) and rho1 within [`SAME_SOLUTION_MM`] (1 + L1 + |rho1|), |rho1| `q`'s. Scaled by the
+/// machine's size (L1), not only by |rho1|, which depends on where the slider's zero is: where
+/// leg I is stretched (a fold of eq. (10)), Newton stops a few 1e-6 mm from the posture, which
+/// the rounding fixes only to sqrt(eps) L1.
+#[inline]
+fn same_posture(l1: f64, found: &PathPoint, q: &PathPoint) -> bool {
+    wrap_angle(found.theta1 - q.theta1).abs() < SAME_SOLUTION_RAD
+        && (found.rho1 - q.rho1).abs() < SAME_SOLUTION_MM * (1.0 + l1 + q.rho1.abs())
+}
+
 /// The leg-I postures polished by Newton from three lists of seeds (theta1, rho1), duplicates
 /// merged: `proved`, one per proved root of F, each of which must polish to a posture within
 /// [`ROOT_POLISH_RAD`] of its theta1; `allowed`, postures an ambiguous interval's resolution
@@ -295,15 +306,7 @@ fn polish_postures(
         if k < n_proved && wrap_angle(q.theta1 - theta1).abs() > ROOT_POLISH_RAD {
             *certificate = Certificate::Unproved;
         }
-        // Scaled by the machine's size (L1), not only by |rho1|, which depends on where the
-        // slider's zero is: where leg I is stretched (a fold of eq. (10)), Newton stops a few
-        // 1e-6 mm from the posture, which the rounding fixes only to sqrt(eps) L1.
-        let same_mm = SAME_SOLUTION_MM * (1.0 + g.l1 + q.rho1.abs());
-        let dup = pairs.iter().any(|o| {
-            wrap_angle(o.theta1 - q.theta1).abs() < SAME_SOLUTION_RAD
-                && (o.rho1 - q.rho1).abs() < same_mm
-        });
-        if dup {
+        if pairs.iter().any(|o| same_posture(g.l1, o, &q)) {
             continue;
         }
         if k >= n_expected || pairs.is_full() {
@@ -463,6 +466,41 @@ pub fn machine_ik_into(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// [`same_posture`] merges a posture within [`SAME_SOLUTION_MM`] (1 + L1 + |rho1|) in rho1
+    /// and [`SAME_SOLUTION_RAD`] in theta1, also across pi, and no further: each checked at 0.99
+    /// and 1.01 of its tolerance, either side, with rho1 from -1e4 to 1e4 mm and L1 from 1 to
+    /// 1e3 mm.
+    #[test]
+    fn same_posture_is_within_both_tolerances() {
+        use std::f64::consts::PI;
+        let point = |theta1: f64, rho1: f64| {
+            let (sin, cos) = theta1.sin_cos();
+            PathPoint {
+                theta1,
+                sin,
+                cos,
+                rho1,
+            }
+        };
+        for l1 in [1.0, 1e3] {
+            for rho1 in [-1e4, 0.0, 250.0] {
+                for theta1 in [0.3, PI - 0.4 * SAME_SOLUTION_RAD] {
+                    let q = point(theta1, rho1);
+                    let tol = SAME_SOLUTION_MM * (1.0 + l1 + rho1.abs());
+                    for (f, same) in [(0.99, true), (1.01, false)] {
+                        for sign in [1.0, -1.0] {
+                            let moved = point(theta1, rho1 + sign * f * tol);
+                            assert_eq!(same_posture(l1, &moved, &q), same, "{moved:?} {q:?}");
+                            let turned =
+                                point(wrap_angle(theta1 + sign * f * SAME_SOLUTION_RAD), rho1);
+                            assert_eq!(same_posture(l1, &turned, &q), same, "{turned:?} {q:?}");
+                        }
+                    }
+                }
+            }
+        }
+    }
 
     /// The leg-I path of a tool pose on the default machine.
     fn path(m: &Machine, phi1: f64, phi2: f64) -> Leg1Path<'_> {

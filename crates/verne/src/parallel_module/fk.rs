@@ -381,6 +381,15 @@ fn det_zero_starts(
     }
 }
 
+/// A mode already found is `pose` again: alpha within [`SAME_SOLUTION_RAD`] (either side of
+/// pi) and P within [`SAME_SOLUTION_MM`] (1 + |P|) in every coordinate, |P| the largest of
+/// `pose`'s.
+#[inline]
+fn same_mode(found: &ModulePose, pose: &ModulePose) -> bool {
+    wrap_angle(found.alpha - pose.alpha).abs() < SAME_SOLUTION_RAD
+        && (found.p - pose.p).amax() < SAME_SOLUTION_MM * (1.0 + pose.p.amax())
+}
+
 /// The modes polished (Newton on eqs. (3)-(6)) from three lists of starts, duplicates merged,
 /// into `out`: `proved`, one per proved root of F, each of which must polish within
 /// [`ROOT_POLISH_RAD`] of its alpha; `allowed`, starts that hold at most one mode each and may
@@ -416,11 +425,7 @@ fn polish_modes(
             alpha: wrap_angle(pose.alpha),
             ..pose
         };
-        let dup = out.iter().any(|o| {
-            wrap_angle(o.pose.alpha - pose.alpha).abs() < SAME_SOLUTION_RAD
-                && (o.pose.p - pose.p).amax() < SAME_SOLUTION_MM * (1.0 + pose.p.amax())
-        });
-        if dup {
+        if out.iter().any(|o| same_mode(&o.pose, &pose)) {
             continue;
         }
         if k >= n_expected || out.is_full() {
@@ -451,6 +456,36 @@ pub fn working(modes: &[FkMode]) -> Option<&FkMode> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// [`same_mode`] merges a mode within [`SAME_SOLUTION_MM`] (1 + |P|) in every coordinate and
+    /// [`SAME_SOLUTION_RAD`] in alpha, also across pi, and no further: each checked at 0.99 and
+    /// 1.01 of its tolerance, either side, with |P| from 0 to 1e4 mm.
+    #[test]
+    fn same_mode_is_within_both_tolerances() {
+        use std::f64::consts::PI;
+        for scale in [0.0, 1.0, 300.0, 1e4] {
+            for alpha in [0.3, PI - 0.4 * SAME_SOLUTION_RAD] {
+                let p = Vector3::new(-0.5 * scale, scale, 0.25 * scale);
+                let pose = ModulePose { p, alpha };
+                let tol = SAME_SOLUTION_MM * (1.0 + scale);
+                for (f, same) in [(0.99, true), (1.01, false)] {
+                    for sign in [1.0, -1.0] {
+                        for axis in 0..3 {
+                            let mut found = pose;
+                            found.p[axis] += sign * f * tol;
+                            assert_eq!(same_mode(&found, &pose), same, "{found:?} {pose:?}");
+                        }
+                        let turned = alpha + sign * f * SAME_SOLUTION_RAD;
+                        let found = ModulePose {
+                            p,
+                            alpha: wrap_angle(turned),
+                        };
+                        assert_eq!(same_mode(&found, &pose), same, "{found:?} {pose:?}");
+                    }
+                }
+            }
+        }
+    }
 
     /// The points on the four spheres at a fixed alpha (the cross-check where condition (21)
     /// fails) hold the pose the sliders were computed from: P, its working branch's alpha and
