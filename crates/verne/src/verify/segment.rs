@@ -359,3 +359,81 @@ fn interior(
     }
     out.extend(singular);
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Where Newton from the previous pose fails, `track` falls back to the forward
+    /// kinematics: the mode nearest the previous pose (by `pose_distance`), assembled within
+    /// [`ACCEPT_RESIDUAL_MM`]. Slider triples of poses through the default machine's
+    /// workspace, from previous poses far off in position and alpha; where Newton succeeds,
+    /// its pose is kept. Both cases are counted.
+    #[test]
+    fn track_falls_back_to_the_nearest_mode_where_newton_fails() {
+        let m = Machine::default_verne();
+        let g = &m.module;
+        let (mut fell_back, mut kept) = (0, 0);
+        for (x, y, z) in [
+            (0.0, 0.0, 0.0),
+            (-150.0, 80.0, 120.0),
+            (200.0, -120.0, -60.0),
+        ] {
+            let p = Vector3::new(x, y, z);
+            for branch in crate::parallel_module::ik::solve(&m, &p).iter() {
+                let rho = branch.rho;
+                for (dp, alpha) in [(0.0, 3.0), (400.0, 1.5), (3000.0, -2.5), (1e4, 0.0)] {
+                    let prev = ModulePose {
+                        p: p + Vector3::new(dp, -dp, dp),
+                        alpha,
+                    };
+                    let got = track(&m, &prev, &rho).expect("the sliders are assembled");
+                    assert!(residual_mm(g, &got, &rho) <= ACCEPT_RESIDUAL_MM, "{got:?}");
+                    let newton = polish_pose(g, prev, &rho);
+                    if residual_mm(g, &newton, &rho) <= ACCEPT_RESIDUAL_MM {
+                        assert_eq!(got, newton);
+                        kept += 1;
+                        continue;
+                    }
+                    let modes = crate::parallel_module::fk::solve(&m, &rho);
+                    let nearest = modes
+                        .iter()
+                        .map(|md| pose_distance(g, &md.pose, &prev))
+                        .fold(f64::INFINITY, f64::min);
+                    assert_eq!(pose_distance(g, &got, &prev), nearest, "{got:?} {prev:?}");
+                    fell_back += 1;
+                }
+            }
+        }
+        assert!(
+            fell_back >= 4 && kept >= 4,
+            "{fell_back} fell back, {kept} kept"
+        );
+    }
+
+    /// Two poses' distance (mm) is the larger of their largest coordinate difference and their
+    /// alpha difference (wrapped) as an arc at R2.
+    #[test]
+    fn pose_distance_weighs_alpha_at_r2() {
+        let m = Machine::default_verne();
+        let g = &m.module;
+        let a = ModulePose {
+            p: Vector3::new(10.0, -20.0, 30.0),
+            alpha: 3.0,
+        };
+        let moved = |dp: Vector3<f64>, da: f64| ModulePose {
+            p: a.p + dp,
+            alpha: wrap_angle(a.alpha + da),
+        };
+        let d = |b: &ModulePose| pose_distance(g, &a, b);
+        assert_eq!(d(&moved(Vector3::new(0.0, -5.0, 1.0), 0.0)), 5.0);
+        let arc = d(&moved(Vector3::zeros(), 0.1));
+        assert!((arc - 0.1 * g.r_big2).abs() < 1e-9 * g.r_big2, "{arc}");
+        // 3.2 rad is -3.08 wrapped: the difference is still 0.2 rad.
+        let across_pi = d(&moved(Vector3::new(1.0, 0.0, 0.0), 0.2));
+        assert!(
+            (across_pi - 0.2 * g.r_big2).abs() < 1e-9 * g.r_big2,
+            "{across_pi}"
+        );
+    }
+}
