@@ -1371,6 +1371,42 @@ mod tests {
         }
     }
 
+    /// `next_to_cut` holds an angle within 16 roundings of the cut (relative to |cut|, at
+    /// least 1) and no further: at each chart's cut, 15 and 17 of them either side (the duplicates
+    /// `dd_roots_reports_a_root_at_a_charts_edge_once` builds lie within a few units: a
+    /// tolerance several times narrower passed it).
+    #[test]
+    fn next_to_cut_is_sixteen_roundings_wide() {
+        for cut in [-FRAC_PI_2, FRAC_PI_2, PI + FRAC_PI_2, 0.5] {
+            let unit = f64::EPSILON * f64::abs(cut).max(1.0);
+            for sign in [1.0, -1.0] {
+                assert!(next_to_cut(cut + sign * 15.0 * unit, cut), "{cut} {sign}");
+                assert!(!next_to_cut(cut + sign * 17.0 * unit, cut), "{cut} {sign}");
+            }
+        }
+    }
+
+    /// `Polys::refine` keeps its Newton steps inside the bracket: on p = (t - 1/2)^3 + 1/8 =
+    /// t^3 - 3/2 t^2 + 3/4 t (monotone, its only real root 0), the bracket [-1/4, 5/4] has its
+    /// middle at p's flat point, where Newton's step goes to -inf. Bisected instead, the root is
+    /// found to rounding (no test's bracket made a step leave it before).
+    #[test]
+    fn refine_keeps_to_its_bracket_where_newton_leaves_it() {
+        let p = [0.0, 0.75, -1.5, 1.0].map(Tracked::exact);
+        let d1 = derivative(&p);
+        let d2 = derivative(&d1);
+        let d3 = derivative(&d2);
+        let polys = Polys {
+            p: &p,
+            d1: &d1,
+            d2: &d2,
+            d3: &d3,
+        };
+        assert_eq!(horner(&d1, 0.5).0, 0.0);
+        let x = polys.refine(-0.25, 1.25, true);
+        assert!(x.abs() < 1e-15, "{x}");
+    }
+
     /// A factor linear in the angle: its root is proved and found.
     #[test]
     fn factor_roots_of_a_line() {
