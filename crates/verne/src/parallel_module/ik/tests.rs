@@ -563,11 +563,12 @@ fn chebyshev_step_on_leg1_is_of_order_three() {
 /// rad (and 70 d mm) off a root, Chebyshev's from 1e-2 and 1e-3 (about 27,000 postures on five
 /// machines; the errors left far above the roots' rounding), each unknown is within its
 /// prediction but for the next order's (1 + 4 d; measured at most 1 + 1.7 d), and on the
-/// worst posture the error is at least 0.9 of it (measured 1.0: the prediction is sharp).
+/// worst posture the error is at least 0.9 of it, in each unknown (measured 0.978 to 1.017:
+/// the prediction is sharp in both).
 #[test]
 fn leg1_steps_predict_the_error_they_leave() {
     let cases = [(false, 1e-3), (false, 1e-4), (true, 1e-2), (true, 1e-3)];
-    let mut worst = [0.0f64; 4];
+    let mut worst = [[0.0f64; 2]; 4];
     for (m, roots) in leg1_roots(14) {
         for (p, root) in &roots {
             let eqs = Leg1Equations::new(&m.module, p);
@@ -580,18 +581,21 @@ fn leg1_steps_predict_the_error_they_leave() {
                     eqs.newton_step(&start, f, dz).expect("a step")
                 };
                 let (ea, er) = off(&step.leg1, root);
-                let ratio = (ea / step.left[0]).max(er / step.left[1]);
+                let ratio = [ea / step.left[0], er / step.left[1]];
                 assert!(
-                    ratio <= 1.0 + 4.0 * d,
+                    ratio[0].max(ratio[1]) <= 1.0 + 4.0 * d,
                     "{p:?} from {start:?}: {ea:e} rad, {er:e} mm left, {:?} predicted",
                     step.left
                 );
-                *worst = worst.max(ratio);
+                *worst = [worst[0].max(ratio[0]), worst[1].max(ratio[1])];
             }
         }
     }
     for ((chebyshev, d), worst) in cases.into_iter().zip(worst) {
-        assert!(worst >= 0.9, "Chebyshev {chebyshev}, {d:e}: {worst}");
+        assert!(
+            worst.into_iter().all(|w| w >= 0.9),
+            "Chebyshev {chebyshev}, {d:e}: {worst:?}"
+        );
     }
 }
 
