@@ -18,6 +18,7 @@ use arrayvec::ArrayVec;
 use nalgebra::Vector3;
 
 use crate::certificate::Certificate;
+use crate::math::certify::{self, DdVerdict};
 use crate::math::cpu;
 use crate::math::cubic::{cubic_roots_in, cubic_roots_in_with_error, deflated_roots_in};
 use crate::math::dd::Tracked;
@@ -295,27 +296,28 @@ fn touching_postures(
             }
             Err(()) => {
                 // Two postures of one sign about to merge: the cubic in double-double.
-                match crate::math::certify::poly_roots(&eq9_tracked(g, p), c_lo, c_hi) {
-                    Ok(found) if found.decided_up_to_same_root() => {
+                let found = certify::poly_roots(&eq9_tracked(g, p), c_lo, c_hi);
+                match certify::dd_verdict(found, c_lo, c_hi) {
+                    DdVerdict::Decided { roots, undecided } => {
                         certificate = certificate.max(Certificate::Extended);
-                        for c in found.roots {
+                        for c in roots {
                             postures_at_root(g, p, c, push);
                         }
                         // At most one root in each (the same solution): taken where leg I's
                         // equations hold at it.
-                        for [a, b] in found.undecided {
-                            postures_at_root(g, p, 0.5 * (a + b), &mut |l: Leg1| {
+                        for (_, middle) in undecided {
+                            postures_at_root(g, p, middle, &mut |l: Leg1| {
                                 if leg1_residual_mm(g, p, &l) <= ACCEPT_RESIDUAL_MM {
                                     push(l);
                                 }
                             });
                         }
-                        continue;
                     }
-                    _ => {}
+                    DdVerdict::Unproved { .. } => {
+                        certificate = Certificate::Unproved;
+                        unproved_touching_postures(g, p, ct, push);
+                    }
                 }
-                certificate = Certificate::Unproved;
-                unproved_touching_postures(g, p, ct, push);
             }
         }
     }
