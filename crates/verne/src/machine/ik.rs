@@ -469,7 +469,7 @@ mod tests {
 
     /// [`same_posture`] merges a posture within [`SAME_SOLUTION_MM`] (1 + L1 + |rho1|) in rho1
     /// and [`SAME_SOLUTION_RAD`] in theta1, also across pi, and no further: each checked at 0.99
-    /// and 1.01 of its tolerance, either side, with rho1 from -1e4 to 1e4 mm and L1 from 1 to
+    /// and 1.01 of its tolerance, either side, with rho1 at -1e4, 0 and 250 mm and L1 at 1 and
     /// 1e3 mm.
     #[test]
     fn same_posture_is_within_both_tolerances() {

@@ -341,8 +341,10 @@ pub(crate) enum DdVerdict {
     },
 }
 
-/// Sorts what [`dd_roots`] found on the piece [lo, hi] into what it proves ([`DdVerdict`]):
-/// the one decision both proofs by double-double make.
+/// Sorts what an isolation in double-double ([`dd_roots`] or [`poly_roots`]) found on the piece
+/// [lo, hi] into what it proves ([`DdVerdict`]): the one decision of the three proofs by
+/// double-double (the forward kinematics', leg I's along a tool pose, and the module's inverse
+/// kinematics' at a touching root of eq. (9)).
 pub(crate) fn dd_verdict(found: Result<DdRoots, ()>, lo: f64, hi: f64) -> DdVerdict {
     let middle = |[a, b]: [f64; 2]| 0.5 * (a + b);
     match found {
@@ -1296,10 +1298,10 @@ mod tests {
     /// `dd_verdict` proves what double-double decided up to one solution per narrow interval,
     /// with each interval's exact middle, and where it did not (an interval wider than
     /// [`SAME_ROOT_WIDTH`], or `Err`), proves nothing and gives every candidate: the roots, the
-    /// middles of the intervals, then the piece's. The ends are chosen so that the middles are
-    /// exact (dyadic) and any other operation gives another number. Both solvers' best-effort branches
-    /// are reached only here: no input is known for which double-double leaves a wide
-    /// interval.
+    /// middles of the intervals, then the piece's. The ends are dyadic, so the middles are exact
+    /// and any other operation gives another number. The verdict `Unproved` is reached only
+    /// here: no input is known for which double-double leaves a wide interval, so the callers'
+    /// best-effort branches, which it sends the piece to, are reached by no test.
     #[test]
     fn dd_verdict_sorts_what_double_double_proves() {
         // Dyadic ends: every middle below is exact.
@@ -1372,7 +1374,8 @@ mod tests {
     }
 
     /// `next_to_cut` holds an angle within 16 roundings of the cut (relative to |cut|, at
-    /// least 1) and no further: at each chart's cut, 15 and 17 of them either side (the duplicates
+    /// least 1) and no further: at each chart's cut, and at 0.5 for the floor at 1, 15 and 17
+    /// of them either side (the duplicates
     /// `dd_roots_reports_a_root_at_a_charts_edge_once` builds lie within a few units: a
     /// tolerance several times narrower passed it).
     #[test]

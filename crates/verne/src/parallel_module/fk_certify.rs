@@ -408,8 +408,10 @@ mod tests {
     /// error added); and the bound is at least [`CHARACTERISTIC_OPS`] roundings of the formula's
     /// magnitude at every angle ([`Tracked`]'s, computed term by term at that angle) and at most
     /// 4 times the largest (measured up to 1.8; F's actual error up to 0.0074 of the bound).
-    /// Sliders from 1 to 1e5 mm on the default machine and four random ones, and the triples of
-    /// `DET_B_DELTA_ZERO`.
+    /// And the bound is the formula it states, to 1e-12: that magnitude with every form at its
+    /// norm (the formal point sin = cos = 1), which catches a term dropped that the floor's
+    /// slack would hide. Sliders from 1 to 1e5 mm on the default machine and four random ones,
+    /// and the triples of `DET_B_DELTA_ZERO`.
     #[test]
     fn characteristic_error_covers_the_rounding_of_f() {
         let mut unit = crate::math::test_rng::lcg(0xc4a2_e770);
@@ -457,8 +459,8 @@ mod tests {
                     m.name
                 );
                 // The bound is loose by up to 1.8 there, more than some of its terms weigh, so
-                // each term is checked by what the bound says it is: the formula's magnitude
-                // with every form at its norm |c0| + |cc| + |cs|, which is the magnitude at the
+                // it is checked against the formula it states: the formula's magnitude with
+                // every form at its norm |c0| + |cc| + |cs|, which is the magnitude at the
                 // formal point sin = cos = 1.
                 let one = Tracked::exact(1.0);
                 let formula = CHARACTERISTIC_OPS * f64::EPSILON * f_at(one, one).mag;

@@ -322,8 +322,10 @@ mod tests {
     /// [`equation_error`] bounds the rounding of eq. (15)'s evaluation: it is at least
     /// [`EQUATION_OPS`] roundings of the formula's magnitude at every theta1 (each linear form
     /// taken term by term in absolute value there, which is what rounding scales with), and at
-    /// most 16 times that (measured up to 5.3). Tool poses on five machines, points from 1 to
-    /// 1e5 mm, phi1 anywhere, theta1 at 256 angles.
+    /// most 16 times that (measured up to 5.3). And the bound is the formula it states, to
+    /// 1e-12: that magnitude with every form at its norm (the formal point sin = cos = 1), which
+    /// catches a term dropped that the floor's slack would hide. Tool poses on five machines,
+    /// points from 1 to 1e5 mm, phi1 anywhere, theta1 at 256 angles.
     #[test]
     fn equation_error_covers_the_formulas_magnitude() {
         let mut unit = crate::math::test_rng::lcg(0x1e91_ce27);
@@ -356,7 +358,7 @@ mod tests {
                     m.name
                 );
                 // The bound is loose by up to 5.3 there, more than some of its terms weigh, so
-                // each term is checked by what the bound says it is: the magnitude of the formula
+                // it is checked against the formula it states: the magnitude of the formula
                 // R1^2 sa^2 (u^2 - K1) + yp^2 (R1^2 + r1^2 - 2 R1 r1 cos a) as [`Tracked`] sums
                 // it, every form at its norm |c0| + |cc| + |cs| (the formal point sin = cos = 1).
                 let t = path_forms::<Tracked>(m, &w, sp, cp);

@@ -367,8 +367,8 @@ mod tests {
     /// Where Newton from the previous pose fails, `track` falls back to the forward
     /// kinematics: the mode nearest the previous pose (by `pose_distance`), assembled within
     /// [`ACCEPT_RESIDUAL_MM`]. Slider triples of poses through the default machine's
-    /// workspace, from previous poses far off in position and alpha; where Newton succeeds,
-    /// its pose is kept. Both cases are counted.
+    /// workspace, from previous poses 0 to 1e4 mm off in position, with alpha at 3, 1.5, -2.5
+    /// and 0 rad; where Newton succeeds, its pose is kept. Both cases are counted.
     #[test]
     fn track_falls_back_to_the_nearest_mode_where_newton_fails() {
         let m = Machine::default_verne();
