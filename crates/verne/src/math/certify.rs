@@ -1375,9 +1375,8 @@ mod tests {
 
     /// `next_to_cut` holds an angle within 16 roundings of the cut (relative to |cut|, at
     /// least 1) and no further: at each chart's cut, and at 0.5 for the floor at 1, 15 and 17
-    /// of them either side (the duplicates
-    /// `dd_roots_reports_a_root_at_a_charts_edge_once` builds lie within a few units: a
-    /// tolerance several times narrower passed it).
+    /// of them either side. The duplicates that `dd_roots_reports_a_root_at_a_charts_edge_once`
+    /// builds lie within a few units, so a tolerance several times narrower passed it.
     #[test]
     fn next_to_cut_is_sixteen_roundings_wide() {
         for cut in [-FRAC_PI_2, FRAC_PI_2, PI + FRAC_PI_2, 0.5] {
