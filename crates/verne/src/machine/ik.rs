@@ -474,15 +474,6 @@ mod tests {
     #[test]
     fn same_posture_is_within_both_tolerances() {
         use std::f64::consts::PI;
-        let point = |theta1: f64, rho1: f64| {
-            let (sin, cos) = theta1.sin_cos();
-            PathPoint {
-                theta1,
-                sin,
-                cos,
-                rho1,
-            }
-        };
         for l1 in [1.0, 1e3] {
             for rho1 in [-1e4, 0.0, 250.0] {
                 for theta1 in [0.3, PI - 0.4 * SAME_SOLUTION_RAD] {
