@@ -20,9 +20,10 @@ use std::sync::{Arc, Mutex};
 
 use nalgebra::{SVector, Vector3};
 
+use super::row::mode_of_kind;
 use super::{
     Item, JointSource, Joints, PairingError, PathPoint, RowSource, Summary, VerifyOptions,
-    Violation, machine_kind, verify,
+    Violation, verify,
 };
 use crate::machine::orientation::{move_angles, tool_axis};
 use crate::machine::{MachineFkModes, machine_fk};
@@ -335,13 +336,8 @@ impl<E> RowSource for Projected<'_, E> {
             // from these modes: they go with the row).
             let modes = machine_fk(self.machine, &q.rho, q.theta1, q.theta2, self.tool_length);
             let modes = &**self.modes.insert(Box::new(modes));
-            let mode = modes
-                .iter()
-                .filter(|md| machine_kind(md.config, md.module.alpha, self.machine))
-                .min_by(|a, b| {
-                    let near = |t: &Vector3<f64>| self.previous.map_or(0.0, |p| (t - p.tip).norm());
-                    near(&a.tool.tip).total_cmp(&near(&b.tool.tip))
-                })?;
+            let previous = self.previous.as_ref().map(|p| &p.tip);
+            let mode = mode_of_kind(modes, self.machine, previous)?;
             self.path
                 .nearest(&mode.tool.tip, mode.tool.phi1, mode.tool.phi2)
         });

@@ -2,6 +2,21 @@
 //! intended pose, limits, singularity proximity.
 
 use super::*;
+use crate::machine::MachineFkMode;
+
+/// The assembly mode a joint row is taken in: of the modes of the machine's kind, the one whose
+/// tip is nearest `tip`; the first of them when `tip` is `None` or on a tie.
+pub(super) fn mode_of_kind<'a>(
+    modes: &'a MachineFkModes,
+    m: &Machine,
+    tip: Option<&Vector3<f64>>,
+) -> Option<&'a MachineFkMode> {
+    let near = |md: &MachineFkMode| tip.map_or(0.0, |p| (md.tool.tip - p).norm());
+    modes
+        .iter()
+        .filter(|md| machine_kind(md.config, md.module.alpha, m))
+        .min_by(|a, b| near(a).total_cmp(&near(b)))
+}
 
 /// Row checks: branch (working assembly mode), tip and axis errors, limits, singularity.
 pub(super) fn eval_row(
@@ -68,15 +83,7 @@ pub(super) fn eval_row(
             &computed
         }
     };
-    let chosen = modes
-        .iter()
-        .filter(|md| machine_kind(md.config, md.module.alpha, m))
-        .min_by(|a, b| {
-            (a.tool.tip - point.tip)
-                .norm()
-                .total_cmp(&(b.tool.tip - point.tip).norm())
-        });
-    let Some(mode) = chosen else {
+    let Some(mode) = mode_of_kind(modes, m, Some(&point.tip)) else {
         let listed: Vec<String> = modes
             .iter()
             .map(|md| {
@@ -319,4 +326,86 @@ pub(super) fn max_tilt(m: &Machine, pose: &ModulePose, rho: &Sliders) -> (usize,
             if t > acc.1 { (k, t) } else { acc }
         },
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::machine::ToolPose;
+
+    /// `mode_of_kind` takes the nearest of the modes of the machine's kind, and skips nearer
+    /// ones of another kind. No slider row of the test machines is known to have two modes of
+    /// the kind (docs/reliability.md), so the modes are built from the working mode of a real
+    /// row: copies with the tip moved along itself to 0.95 T and 0.99 T (so |t + T| would
+    /// pick the other), a twin of the second with the same tip (a tie), and two at T itself
+    /// of another kind: a configuration not the working one, and alpha with R1 cos(alpha)
+    /// below r1.
+    #[test]
+    fn the_row_is_taken_in_the_nearest_mode_of_the_machines_kind() {
+        let m = Machine::default_verne();
+        let p = Vector3::new(40.0, -25.0, 1000.0);
+        let branch =
+            *crate::parallel_module::ik::working(&crate::parallel_module::ik::solve(&m, &p))
+                .expect("a working branch at the test point");
+        let real = machine_fk(&m, &branch.rho, 0.2, -0.3, 100.0);
+        let working = *real
+            .iter()
+            .find(|md| machine_kind(md.config, md.module.alpha, &m))
+            .expect("the row's mode of the machine's kind");
+        let target = working.tool.tip;
+        assert!(
+            target.norm() > 100.0,
+            "a tip away from the origin: {target}"
+        );
+        let moved = |scale: f64| MachineFkMode {
+            tool: ToolPose {
+                tip: target * scale,
+                ..working.tool
+            },
+            ..working
+        };
+        let (far, near) = (moved(0.95), moved(0.99));
+        let other_config = MachineFkMode {
+            config: [1, -1, -1],
+            ..working
+        };
+        let crossing = MachineFkMode {
+            module: ModulePose {
+                alpha: (m.module.r_small1 / m.module.r_big1).acos() + 0.01,
+                ..working.module
+            },
+            ..working
+        };
+        assert!(!machine_kind(
+            other_config.config,
+            other_config.module.alpha,
+            &m
+        ));
+        assert!(!machine_kind(crossing.config, crossing.module.alpha, &m));
+        // The same tip as `near`, after it: a tie.
+        let near_twin = MachineFkMode {
+            module: ModulePose {
+                alpha: near.module.alpha + 1e-3,
+                ..near.module
+            },
+            ..near
+        };
+        let mut modes = MachineFkModes::new();
+        for md in [other_config, far, crossing, near, near_twin] {
+            modes.push(md);
+        }
+        let index_of = |tip: Option<&Vector3<f64>>| {
+            let chosen = mode_of_kind(&modes, &m, tip)?;
+            modes.iter().position(|md| std::ptr::eq(md, chosen))
+        };
+        // Nearest the row's own tip: `near`, and the first of it and its twin.
+        assert_eq!(index_of(Some(&target)), Some(3));
+        assert_eq!(index_of(Some(&(target * 0.9))), Some(1));
+        // No tip to be near: the first of the kind.
+        assert_eq!(index_of(None), Some(1));
+        let mut none_of_kind = MachineFkModes::new();
+        none_of_kind.push(other_config);
+        none_of_kind.push(crossing);
+        assert!(mode_of_kind(&none_of_kind, &m, Some(&target)).is_none());
+    }
 }
