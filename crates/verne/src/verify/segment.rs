@@ -325,23 +325,13 @@ fn interior(
         if around[2].is_nan() {
             around[2] = max_tilt(m, &b.module, &qb.rho).1;
         }
-        // Parabola through the worst sample and its neighbours: refine the maximum.
-        let (f0, f1, f2) = (around[0], around[1], around[2]);
-        let den = f0 - 2.0 * f1 + f2;
-        let mut best = (j as f64 / n as f64, t, rod);
-        if den < 0.0 {
-            let off = 0.5 * (f0 - f2) / den;
-            if off.abs() < 1.0 {
-                let s = (j as f64 + off) / n as f64;
-                let rho = qa.rho + drho * s;
-                if let Some(p) = track(m, &wpose, &rho) {
-                    let (r2, t2) = max_tilt(m, &p, &rho);
-                    if t2 > best.1 {
-                        best = (s, t2, r2);
-                    }
-                }
-            }
-        }
+        let best = refine_worst(j, n, (t, rod), around, |s| {
+            let rho = qa.rho + drho * s;
+            track(m, &wpose, &rho).map(|p| {
+                let (r2, t2) = max_tilt(m, &p, &rho);
+                (t2, r2)
+            })
+        });
         out.push(Violation::over(
             row,
             Check::Limits,
@@ -360,9 +350,74 @@ fn interior(
     out.extend(singular);
 }
 
+/// The worst tilt sample, sample `j` of `n` with (tilt, rod) `worst`, refined by the parabola
+/// through its tilt and its neighbours' (`around`): (s, tilt, rod) of the vertex when `probe`
+/// finds the tilt there higher, else of the sample. `probe(s)` is (tilt, rod) at s, `None`
+/// where the segment cannot be tracked.
+fn refine_worst(
+    j: usize,
+    n: usize,
+    worst: (f64, usize),
+    around: [f64; 3],
+    probe: impl FnOnce(f64) -> Option<(f64, usize)>,
+) -> (f64, f64, usize) {
+    let (f0, f1, f2) = (around[0], around[1], around[2]);
+    let den = f0 - 2.0 * f1 + f2;
+    let mut best = (j as f64 / n as f64, worst.0, worst.1);
+    if den < 0.0 {
+        let off = 0.5 * (f0 - f2) / den;
+        if off.abs() < 1.0 {
+            let s = (j as f64 + off) / n as f64;
+            if let Some((t2, r2)) = probe(s)
+                && t2 > best.1
+            {
+                best = (s, t2, r2);
+            }
+        }
+    }
+    best
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The parabola through tilts 1, 2 and 1.5 at samples 9, 10 and 11 of 40 peaks 1/6 of a
+    /// sample past 10 (vertex of f0 - 2 f1 + f2 < 0 at 0.5 (f0 - f2) / (f0 - 2 f1 + f2)). The
+    /// tilt found there is taken only when it is higher than the sample's (2.1: the vertex;
+    /// 2.0, 1.9 or not tracked: sample 10 at s = 0.25). Flat tilts, or a vertex a sample or
+    /// more away, are not probed.
+    #[test]
+    fn the_worst_tilt_is_refined_only_where_the_vertex_is_higher() {
+        let vertex = (10.0 + 1.0 / 6.0) / 40.0;
+        let sample = (0.25, 2.0, 1);
+        for (found, expect) in [
+            (Some((2.1, 2)), (vertex, 2.1, 2)),
+            (Some((2.0, 2)), sample),
+            (Some((1.9, 2)), sample),
+            (None, sample),
+        ] {
+            let mut probed = None;
+            let best = refine_worst(10, 40, (2.0, 1), [1.0, 2.0, 1.5], |s| {
+                probed = Some(s);
+                found
+            });
+            let s = probed.expect("the vertex is probed");
+            assert!((s - vertex).abs() < 1e-15, "probed at {s}, vertex {vertex}");
+            assert_eq!(best.1, expect.1);
+            assert_eq!(best.2, expect.2);
+            assert!(
+                (best.0 - expect.0).abs() < 1e-15,
+                "{best:?} against {expect:?}"
+            );
+        }
+        for around in [[2.0, 2.0, 2.0], [0.0, 1.0, 1.9]] {
+            let best = refine_worst(10, 40, (2.0, 1), around, |s| {
+                panic!("probed at {s} for tilts {around:?}")
+            });
+            assert_eq!(best, sample);
+        }
+    }
 
     /// Where Newton from the previous pose fails, `track` falls back to the forward
     /// kinematics: the mode nearest the previous pose (by `pose_distance`), assembled within
