@@ -334,12 +334,12 @@ mod tests {
     use crate::machine::ToolPose;
 
     /// `mode_of_kind` takes the nearest of the modes of the machine's kind, and skips nearer
-    /// ones of another kind. No slider row of the test machines is known to have two modes of
-    /// the kind (docs/reliability.md), so the modes are built from the working mode of a real
-    /// row: copies with the tip moved along itself to 0.95 T and 0.99 T (so |t + T| would
-    /// pick the other), a twin of the second with the same tip (a tie), and two at T itself
-    /// of another kind: a configuration not the working one, and alpha with R1 cos(alpha)
-    /// below r1.
+    /// ones of another kind. Real joints with two modes of the kind are rare (tests/verify_rows.rs
+    /// uses one found by a scan), and a tie or a nearer mode of another kind is not known in
+    /// any, so the modes are built from the working mode of a real row: copies with the tip
+    /// moved along itself to 0.95 T and 0.99 T (so |t + T| would pick the other), a twin of
+    /// the second with the same tip (a tie), and two at T itself of another kind: a
+    /// configuration not the working one, and alpha with R1 cos(alpha) below r1.
     #[test]
     fn the_row_is_taken_in_the_nearest_mode_of_the_machines_kind() {
         let m = Machine::default_verne();
