@@ -1409,6 +1409,39 @@ mod tests {
         assert!(x.abs() < 1e-15, "{x}");
     }
 
+    /// A simple root x1 = x2 - 24/65536 just below a double root x2 = 1372/4096, in p = (t -
+    /// x1)(t - x2)^2 with a constant coefficient of magnitude 1e17 (its error about 4e-12, a
+    /// rounding band about 1e-4 either side of x2): the pieces that reach the band have p
+    /// within its error at their 0.3, 0.5 and 0.7 points, so they are split at the middle with
+    /// no sign proved there. x1 is found once, in the gap the band leaves below it, and x2 is
+    /// one undecided interval inside [0, 1]. (With the split point mirrored outside such a
+    /// piece, the search goes back over x1 and finds it again until its list is full: an error.)
+    #[test]
+    fn a_piece_with_no_sign_at_its_split_points_is_split_inside_it() {
+        let x2 = 1372.0 / 4096.0;
+        let x1 = x2 - 24.0 / 65536.0;
+        // Exact in double precision: the values have at most 16 significant bits.
+        let c = [
+            -x1 * x2 * x2,
+            2.0 * x1 * x2 + x2 * x2,
+            -(x1 + 2.0 * x2),
+            1.0,
+        ];
+        let mut p = c.map(Tracked::exact);
+        p[0].mag = 1e17;
+        let out = poly_roots(&p, 0.0, 1.0).unwrap();
+        assert_eq!(out.roots.len(), 1, "{out:?}");
+        assert_eq!(out.undecided.len(), 1, "{out:?}");
+        let [lo, hi] = out.undecided[0];
+        assert!(lo < x2 && x2 < hi && hi - lo < 4e-4, "{out:?}");
+        let root = out.roots[0];
+        let (v, e) = horner(&p, root);
+        assert!(
+            v.abs() <= e && (root - x1).abs() < 1e-4 && root < lo,
+            "{root}: {out:?}"
+        );
+    }
+
     /// A factor linear in the angle: its root is proved and found.
     #[test]
     fn factor_roots_of_a_line() {
