@@ -1442,6 +1442,75 @@ mod tests {
         );
     }
 
+    /// The real roots of c0 + c1 t + c2 t^2 (c2 != 0), in double precision.
+    fn quadratic_roots(c: [f64; 3]) -> Vec<f64> {
+        let disc = c[1] * c[1] - 4.0 * c[2] * c[0];
+        if disc < 0.0 {
+            return Vec::new();
+        }
+        let q = -0.5 * (c[1] + c[1].signum() * disc.sqrt());
+        vec![q / c[2], c[0] / q]
+    }
+
+    /// `poly_roots` promises its answer for every polynomial within the coefficients' errors:
+    /// each root there lies in a piece proved to hold exactly one (a root found) or in an
+    /// undecided interval. Quadratics with dyadic roots, one coefficient given an error of
+    /// 1/32 to 1/2 by its magnitude; for 41 polynomials with that coefficient anywhere in
+    /// 0.999 of its error, the roots in [a, b] outside the undecided intervals are as many as
+    /// the roots found, each nearest a different one. Such large errors put the isolation's
+    /// Taylor tests where the errors of p'(m) and p''(m) decide (each taken away, a piece
+    /// with a root of some of these polynomials was excluded).
+    #[test]
+    fn the_roots_hold_for_every_polynomial_within_the_error() {
+        let unit = f64::from(HALF_ANGLE_OPS) * crate::math::dd::DD_OP_ERROR * (1.0 + 1e-12);
+        // (roots, the coefficient with the error, its error, [a, b]), in 64ths.
+        let cases: [([f64; 2], usize, f64, [f64; 2]); 6] = [
+            ([-41.0, 38.0], 1, 1.0 / 16.0, [-52.0, 37.0]),
+            ([-59.0, 7.0], 1, 1.0 / 8.0, [-55.0, 45.0]),
+            ([-2.0, 46.0], 2, 1.0 / 32.0, [-53.0, 45.0]),
+            ([-57.0, 8.0], 2, 1.0 / 16.0, [-26.0, 8.0]),
+            ([-26.0, 25.0], 2, 1.0 / 16.0, [-26.0, 59.0]),
+            ([-60.0, 62.0], 2, 0.5, [-54.0, 38.0]),
+        ];
+        let (mut roots_checked, mut undecided_seen) = (0, 0);
+        for ([r1, r2], k, err, [a, b]) in cases {
+            let (r1, r2, a, b) = (r1 / 64.0, r2 / 64.0, a / 64.0, b / 64.0);
+            let c = [r1 * r2, -(r1 + r2), 1.0];
+            let mut p = c.map(Tracked::exact);
+            p[k].mag = err / unit;
+            assert!((p[k].error(HALF_ANGLE_OPS) / err - 1.0).abs() < 1e-12);
+            let out = poly_roots(&p, a, b).unwrap();
+            undecided_seen += out.undecided.len();
+            for j in 0..=40 {
+                let mut q = c;
+                q[k] += 0.999 * err * (f64::from(j) / 20.0 - 1.0);
+                let outside: Vec<f64> = quadratic_roots(q)
+                    .into_iter()
+                    .filter(|&x| x >= a && x <= b)
+                    .filter(|&x| !out.undecided.iter().any(|u| x >= u[0] && x <= u[1]))
+                    .collect();
+                let case = format!("{c:?} with c{k} {q:?} on [{a}, {b}]: {outside:?}, {out:?}");
+                assert_eq!(outside.len(), out.roots.len(), "{case}");
+                let mut nearest: Vec<usize> = outside
+                    .iter()
+                    .map(|x| {
+                        let d = |r: &f64| (r - x).abs();
+                        (0..out.roots.len())
+                            .min_by(|&i, &l| d(&out.roots[i]).total_cmp(&d(&out.roots[l])))
+                            .unwrap()
+                    })
+                    .collect();
+                nearest.dedup();
+                assert_eq!(nearest.len(), outside.len(), "{case}");
+                roots_checked += outside.len();
+            }
+        }
+        assert!(
+            roots_checked > 100 && undecided_seen >= 6,
+            "{roots_checked} {undecided_seen}"
+        );
+    }
+
     /// A factor linear in the angle: its root is proved and found.
     #[test]
     fn factor_roots_of_a_line() {
