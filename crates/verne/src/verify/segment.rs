@@ -383,10 +383,10 @@ mod tests {
     use super::*;
 
     /// The parabola through tilts 1, 2 and 1.5 at samples 9, 10 and 11 of 40 peaks 1/6 of a
-    /// sample past 10 (vertex of f0 - 2 f1 + f2 < 0 at 0.5 (f0 - f2) / (f0 - 2 f1 + f2)). The
-    /// tilt found there is taken only when it is higher than the sample's (2.1: the vertex;
-    /// 2.0, 1.9 or not tracked: sample 10 at s = 0.25). Flat tilts, or a vertex a sample or
-    /// more away, are not probed.
+    /// sample past 10 (through (-1, f0), (0, f1), (1, f2) with f0 - 2 f1 + f2 < 0, the vertex
+    /// is at 0.5 (f0 - f2) / (f0 - 2 f1 + f2)). The tilt found there is taken only when it is
+    /// higher than the sample's (2.1: the vertex; 2.0, 1.9 or not tracked: sample 10 at s =
+    /// 0.25). Flat tilts, or a vertex a sample or more away, are not probed.
     #[test]
     fn the_worst_tilt_is_refined_only_where_the_vertex_is_higher() {
         let vertex = (10.0 + 1.0 / 6.0) / 40.0;
