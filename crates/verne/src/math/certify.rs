@@ -1420,7 +1420,7 @@ mod tests {
     fn a_piece_with_no_sign_at_its_split_points_is_split_inside_it() {
         let x2 = 1372.0 / 4096.0;
         let x1 = x2 - 24.0 / 65536.0;
-        // Exact in double precision: the values have at most 16 significant bits.
+        // x1 = 2741/8192 and x2 = 343/1024 (12 and 9 bits): the coefficients are exact.
         let c = [
             -x1 * x2 * x2,
             2.0 * x1 * x2 + x2 * x2,
