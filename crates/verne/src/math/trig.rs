@@ -2005,6 +2005,114 @@ mod tests {
         }
     }
 
+    /// K + (1 - cos u) + b sin u (1 - cos u), u = x - x0: a minimum K at x0 (F' = 0 there, F''
+    /// = 1), with F - K about u^2 / 2 + b u^3 / 2 near it.
+    fn bowl(x0: f64, k: f64, b: f64) -> Trig {
+        // b sin u (1 - cos u) = b (sin u - sin 2u / 2).
+        let (s1, c1) = x0.sin_cos();
+        let (s2, c2) = (2.0 * x0).sin_cos();
+        let mut p = Trig::default();
+        p.cos[0] = k + 1.0;
+        p.cos[1] = -c1 - b * s1;
+        p.sin[1] = -s1 + b * c1;
+        p.cos[2] = 0.5 * b * s2;
+        p.sin[2] = -0.5 * b * c2;
+        p
+    }
+
+    /// The band around a minimum of F within rounding of zero ([`Isolation::band_around`]) ends
+    /// only where F is beyond rounding with the sign of the interval's ends: a point where F has
+    /// that sign but is within rounding is not an end, since a form within the error can be
+    /// below zero there and have its root beyond it. F = [`bowl`] with its minimum K just
+    /// inside the rounding (K = -ef + 1e-4 ce, the coefficient error ce 1e-6 or 1e-8) and b =
+    /// +-0.5: at the band's first point, r0 = sqrt(4 ef / F'') from x0, F is about K + 2 ef on
+    /// one side, beyond rounding, and K + 2 ef - |b| r0^3 / 2 on the other, within it. There the
+    /// form lowered by ce has its root beyond r0: both of its roots must lie in the band.
+    #[test]
+    fn the_band_around_a_minimum_ends_beyond_rounding() {
+        for x0 in [0.0613, -1.234, 2.71] {
+            for b in [0.5, -0.5] {
+                for ce in [1e-6, 1e-8] {
+                    // ef hardly depends on K: take it from the form with K = 0.
+                    let flat = bowl(x0, 0.0, b);
+                    let scale = largest_coefficient(&flat);
+                    let ef = Isolation::with_bounds(&flat, scale, ce * scale, true).ef;
+                    // F is p / scale: K in p's units.
+                    let p = bowl(x0, -(ef - 1e-4 * ce) * scale, b);
+                    let scale = largest_coefficient(&p);
+                    let iso = Isolation::with_bounds(&p, scale, ce * scale, true);
+                    // The premises: the minimum within rounding, and the band's first point on
+                    // the side b points away from within rounding with the ends' sign.
+                    let min = iso.at(x0);
+                    assert!(
+                        min.f < 0.0 && min.f.abs() <= iso.ef,
+                        "{x0} {b} {ce}: {min:?}"
+                    );
+                    let r0 = (4.0 * iso.ef / min.s).sqrt();
+                    let near = iso.at(x0 - b.signum() * r0).f;
+                    assert!(near > 0.0 && near <= iso.ef, "{x0} {b} {ce}: {near}");
+                    assert!(iso.at(x0 + b.signum() * r0).f > iso.ef, "{x0} {b} {ce}");
+                    // The form within the error whose root lies beyond that point.
+                    let mut q = p;
+                    q.cos[0] -= ce * scale;
+                    let roots = sampled_roots(&q);
+                    assert_eq!(roots.len(), 2, "{x0} {b} {ce}: {roots:?}");
+                    let beyond = roots.iter().any(|&r| -b.signum() * (r - x0) > r0);
+                    assert!(beyond, "{x0} {b} {ce}: {roots:?}, r0 {r0}");
+                    let got = assert_certified(&p, ce * scale, &roots, 1e-9);
+                    assert!(got.roots.is_empty(), "{x0} {b} {ce}: {got:?}");
+                    for r in roots {
+                        assert!(
+                            got.ambiguous.iter().any(|&[lo, hi]| r >= lo && r <= hi),
+                            "{x0} {b} {ce}: {r} outside {got:?}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    /// An interval that no test decides is bisected at most [`MAX_DEPTH`] times, then given
+    /// up. F = [`bowl`] at x0 = 0, a grid point, with b = 0: F' is within rounding of zero near
+    /// 0, so the intervals there are not proved monotone; with the coefficient error chosen so
+    /// that F(0) = K lies less than 1e-27 beyond the rounding ef, no root is excluded until h^2
+    /// F'' / 8 < F(0) - ef, h < 1e-13: beyond 40 bisections of the grid step. What is given up
+    /// is one interval about 0, made of whole pieces step / 2^40 on each side; nothing else.
+    #[test]
+    fn an_interval_no_test_decides_is_given_up_at_the_depth_limit() {
+        let step = std::f64::consts::PI / 16.0;
+        let piece = step * 2f64.powi(-(MAX_DEPTH as i32));
+        for size in [1.0, 3.7e21, 2e-30] {
+            for k in [4e-14, 1e-13, 3e-13] {
+                let p = bowl(0.0, k, 0.0).scale(size);
+                let scale = largest_coefficient(&p);
+                let ef = |coef_err: f64| Isolation::with_bounds(&p, scale, coef_err, true).ef;
+                let f0 = Isolation::with_bounds(&p, scale, 0.0, true).f.on_grid()[16];
+                // The largest coefficient error whose rounding stays below F(0).
+                let (mut lo, mut hi) = (0.0, f0 * scale);
+                for _ in 0..200 {
+                    let mid = 0.5 * (lo + hi);
+                    if ef(mid) < f0 {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                let gap = f0 - ef(lo);
+                assert!(gap > 0.0 && gap < 1e-27, "{size} {k}: {gap}");
+                let got = p.roots_certified(lo);
+                assert!(got.roots.is_empty(), "{size} {k}: {got:?}");
+                // F is flat in double precision this near 0 (cos x rounds to 1), so the pieces
+                // given up are those whose F' = sin x is within the rounding ed at their inner
+                // end: n of them on each side.
+                let ed = Isolation::with_bounds(&p, scale, lo, true).ed;
+                let n = (ed / piece).floor() + 1.0;
+                let want = [-n * piece, n * piece];
+                assert_eq!(got.ambiguous.as_slice(), &[want], "{size} {k}: {n} pieces");
+            }
+        }
+    }
+
     /// `eval_error` bounds the rounding of the isolation's evaluation of p (the harmonics by
     /// their recurrences, then the sum) against the same evaluation in double-double, for
     /// random forms (a third of them of cosines or of sines only) and points.
