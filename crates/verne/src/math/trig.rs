@@ -467,8 +467,9 @@ const fn grid_table(sin: bool) -> [[f64; GRID]; MAX_HARMONIC] {
 const GRID_COS: [[f64; GRID]; MAX_HARMONIC] = grid_table(false);
 const GRID_SIN: [[f64; GRID]; MAX_HARMONIC] = grid_table(true);
 
-/// Bisection depth at which an interval that no test decides (a root of multiplicity three or
-/// more, within rounding) is given up and its midpoint reported as a candidate.
+/// Bisection depth at which an interval that no test decides is given up
+/// ([`Isolation::give_up`]): near a root of multiplicity three or more, or an extremum whose
+/// value lies just beyond rounding.
 const MAX_DEPTH: u32 = 40;
 
 /// A point with sin and cos of it and the values of F, F' and F'' there.
@@ -610,9 +611,11 @@ impl Isolation {
     /// g has no zero there. Applied to F (no root), F' (F strictly monotone: one root at most,
     /// exactly where F changes sign) and F'' (F' strictly monotone: at most one critical point,
     /// which splits the interval into two monotone pieces). Intervals none of these decides are
-    /// bisected; the bounds shrink four times per bisection, so only the neighbourhood of a triple
-    /// root can reach [`MAX_DEPTH`]. Runs in the build `AVX2` names ([`crate::math::cpu`]), through
-    /// a function of its own, so that its recursion stays in the build it started in.
+    /// bisected; the bounds shrink four times per bisection, so bisection reaches [`MAX_DEPTH`]
+    /// only where F' is within rounding and F within rounding plus a vanishing margin (a triple
+    /// root, or an extremum whose value lies just beyond rounding). Runs in the build `AVX2`
+    /// names ([`crate::math::cpu`]), through a function of its own, so that its recursion stays
+    /// in the build it started in.
     #[inline(always)]
     fn interval<const AVX2: bool>(&mut self, a: Pt, b: Pt, depth: u32) -> Option<()> {
         #[cfg(target_arch = "x86_64")]
