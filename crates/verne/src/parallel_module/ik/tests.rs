@@ -842,6 +842,80 @@ fn estimated_start_is_of_order_four() {
     }
 }
 
+/// A machine (as a file can give it) whose working posture lies far from the lanes' start: the
+/// eighth of `random_geometries(30, 5)`, rounded to 0.01 mm, with its rods free to tilt to 90
+/// degrees and strokes wide enough for every branch; and a point of it, whose working posture
+/// is at alpha = 0.77 rad.
+fn far_from_the_start() -> (Machine, Vector3<f64>) {
+    let text = "kind = \"verne\"\nname = \"far from the start\"\n\n[module]\n\
+        D1 = -277.24\nd1 = 0.0\nR1 = 138.2\nr1 = 58.82\nL1 = 667.72\n\
+        D2 = 274.57\nd2 = 0.0\nR2 = 310.25\nr4 = 684.55\nL2 = 1132.75\nL3 = 1176.81\n\n\
+        [limits]\nrho1_min = -2000\nrho1_max = 3000\nrho2_min = -2000\nrho2_max = 3000\n\
+        rho3_min = -2000\nrho3_max = 3000\nrod_tilt_max = 90\ntheta1_min = -45\ntheta1_max = 45\n\n\
+        [table]\nd_a = 1400\nd_t = -150\n\n[tool]\nlength = 50\n";
+    let m = Machine::from_toml_str(text, "far from the start").expect("a valid machine");
+    (m, Vector3::new(-19.88, -543.22, 497.4))
+}
+
+/// A first Chebyshev step longer than the sin/cos series allows ([`super::SMALL_ANGLE`]) ends
+/// the lanes' certificate: the point is handed over, and its working branch comes from the
+/// cubic all the same. At the point of [`far_from_the_start`] the start is at alpha = -0.12 rad,
+/// 0.9 rad from the working posture, and the first step, about 5 rad long, leaves sin and cos
+/// off the unit circle by more than 0.1; the steps after it settle there, on a posture that passes every other test of the lanes
+/// (the margins, the isolated root, a feasible lower branch), with a branch that is not the
+/// working one. Only that first step's `usable` keeps the lanes from answering with it.
+#[test]
+fn a_first_step_beyond_the_series_is_handed_over() {
+    use super::{
+        LEG1_MAX_STEPS, SMALL_ANGLE, certified_lanes, clear_of_margins, estimated_start,
+        isolated_working_root, lower_branch, solve_working_each, working_fast, working_lanes,
+    };
+    use crate::parallel_module::branches::cos_tilt_max;
+    let (m, p) = far_from_the_start();
+    let g = &m.module;
+    // The working branch from the roots of the cubic (9), without the lanes.
+    let expected = working_by_cubic(&m, &p).expect("a working branch");
+    assert!((expected.alpha - 0.77).abs() < 0.01, "{expected:?}");
+    // What the steps do when a step beyond the series is not stopped.
+    let (start, usable) = estimated_start(g, &p);
+    assert!(usable && (start.alpha + 0.12).abs() < 0.01, "{start:?}");
+    let eqs = Leg1Equations::new(g, &p);
+    let first = eqs.corrected_step(&start);
+    assert!(
+        !first.usable && (start.alpha - first.leg1.alpha).abs() > SMALL_ANGLE,
+        "{first:?}"
+    );
+    let (mut leg, mut settled) = (first.leg1, first.settled);
+    for _ in 1..LEG1_MAX_STEPS {
+        if settled {
+            break;
+        }
+        let step = eqs.corrected_step(&leg);
+        assert!(step.usable, "{step:?}");
+        (leg, settled) = (step.leg1, step.settled);
+    }
+    assert!((leg.sin.hypot(leg.cos) - 1.0).abs() > 0.1, "{leg:?}");
+    assert!(settled && clear_of_margins(g, &p, &leg) && isolated_working_root(&m, &p));
+    let lower = lower_branch(&m, &p, &leg, cos_tilt_max(&m));
+    assert!(lower.feasible && !lower.close_call, "{lower:?}");
+    assert!(!same_branch(&lower.branch, &expected), "{lower:?}");
+    // The lanes hand the point over, in every lane; the working branch comes all the same, by
+    // every way of asking.
+    assert!(!certified_lanes(&m, &[p]).1[0]);
+    assert_eq!(working_lanes(&m, &[p; 4]), [None; 4]);
+    let fast = working_fast(&m, &p).expect("the working branch");
+    assert!(same_branch(&fast, &expected), "{fast:?} vs {expected:?}");
+    let all = solve(&m, &p);
+    let found = working(&all).expect("the working branch");
+    assert!(same_branch(found, &expected), "{found:?} vs {expected:?}");
+    let mut got = vec![IkBranches::new(); 5];
+    solve_working_each(&m, [p; 5].into_iter().zip(got.iter_mut()));
+    for branches in &got {
+        let found = working(branches).expect("the working branch");
+        assert!(same_branch(found, &expected), "{found:?} vs {expected:?}");
+    }
+}
+
 // ------------------------------------------------------------ the certificate of the lanes
 
 /// The certificate that the cubic (9) has at most one root with cos(alpha) in [r1/R1, 1]
