@@ -1129,41 +1129,52 @@ fn roots_near(m: &Machine, p: &Vector3<f64>, c0: f64) -> Option<usize> {
 /// where the cubic has two roots there and none where it has none, as the test's own
 /// double-double evaluation decides. The points on the root itself, at rounding, and only
 /// those, reach the double-double isolation of the cubic (`Extended`): a search about a
-/// touching root that missed it would send the others there too.
+/// touching root that missed it would send the others there too. The same on the machines and
+/// points scaled by 2^-10 and 2^10 (exactly: the cubic's coefficients scale by k^4, and their
+/// bounds with them). At 2^-10 the coefficients are below 1, where an error bound left
+/// unnormalised, or multiplied by the largest coefficient instead of divided, is smaller, not
+/// larger: the search about a touching root then misses the roots.
 #[test]
 fn postures_at_a_double_root_of_eq9() {
     use super::leg1_residual_mm;
-    let (mut decided, mut extended) = (0, 0);
-    for m in machines() {
-        for (c0, p0) in double_root_points(&m) {
-            let u0 = p0.x + m.module.dx1;
-            for rel in [1e-6, 1e-9, 1e-12, 1e-14, 0.0, -1e-14, -1e-12, -1e-9, -1e-6] {
-                let p = Vector3::new(u0 * (1.0 + rel) - m.module.dx1, p0.y, p0.z);
-                let (legs, certificate) = leg1_postures(&m, &p);
-                let at = format!(
-                    "{}: c0 {c0:.1}, {rel:e} off: {p:?}: {certificate:?} {legs:?}",
-                    m.name
-                );
-                assert!(certificate.proved(), "{at}");
-                // The certified factors of leg I prove every point off the root (two roots
-                // about 1e-7 apart at 1e-14); only those on it need the double-double isolation.
-                assert_eq!(certificate == Certificate::Extended, rel == 0.0, "{at}");
-                extended += usize::from(certificate == Certificate::Extended);
-                for l in &legs {
-                    assert!(leg1_residual_mm(&m.module, &p, l) <= 1e-9, "{at}");
-                }
-                let near = legs.iter().filter(|l| (l.cos - c0).abs() < 1e-2).count();
-                if let Some(expected) = roots_near(&m, &p, c0) {
-                    assert_eq!(near, 2 * expected, "{at}");
-                    decided += 1;
+    for k in [1.0, 2f64.powi(-10), 2f64.powi(10)] {
+        let (mut decided, mut extended) = (0, 0);
+        for m0 in machines() {
+            let m = Machine {
+                module: scaled_module(&m0.module, k),
+                ..m0.clone()
+            };
+            for (c0, p0) in double_root_points(&m0) {
+                let u0 = p0.x + m0.module.dx1;
+                for rel in [1e-6, 1e-9, 1e-12, 1e-14, 0.0, -1e-14, -1e-12, -1e-9, -1e-6] {
+                    let p = Vector3::new(u0 * (1.0 + rel) - m0.module.dx1, p0.y, p0.z) * k;
+                    let (legs, certificate) = leg1_postures(&m, &p);
+                    let at = format!(
+                        "x{k}: {}: c0 {c0:.1}, {rel:e} off: {p:?}: {certificate:?} {legs:?}",
+                        m.name
+                    );
+                    assert!(certificate.proved(), "{at}");
+                    // The certified factors of leg I prove every point off the root (two roots
+                    // about 1e-7 apart at 1e-14); only those on it need the double-double
+                    // isolation.
+                    assert_eq!(certificate == Certificate::Extended, rel == 0.0, "{at}");
+                    extended += usize::from(certificate == Certificate::Extended);
+                    for l in &legs {
+                        assert!(leg1_residual_mm(&m.module, &p, l) <= 1e-9 * k, "{at}");
+                    }
+                    let near = legs.iter().filter(|l| (l.cos - c0).abs() < 1e-2).count();
+                    if let Some(expected) = roots_near(&m, &p, c0) {
+                        assert_eq!(near, 2 * expected, "{at}");
+                        decided += 1;
+                    }
                 }
             }
         }
+        assert!(
+            decided > 100 && extended > 10,
+            "x{k}: {decided} decided, {extended} extended"
+        );
     }
-    assert!(
-        decided > 100 && extended > 10,
-        "{decided} decided, {extended} extended"
-    );
 }
 
 /// The roots of the cubic (9) of `p` that `working_by_cubic` searches, in [r1/R1 - its angle
