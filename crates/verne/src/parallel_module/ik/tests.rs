@@ -168,6 +168,58 @@ fn a_point_gets_the_same_bits_alone_and_side_by_side() {
     }
 }
 
+/// `m` with every length times `k`: the module's (see [`scaled_module`]) and the strokes'
+/// limits.
+fn scaled_machine(m: &Machine, k: f64) -> Machine {
+    let mut scaled = m.clone();
+    scaled.module = scaled_module(&m.module, k);
+    scaled.limits.rho_min = m.limits.rho_min.map(|r| r * k);
+    scaled.limits.rho_max = m.limits.rho_max.map(|r| r * k);
+    scaled
+}
+
+/// The solvers do not depend on the unit of length: each point of a 16^3 grid on five
+/// machines, as built and with their limits opened, and the same point on the machine scaled
+/// by 2^-10 and by 2^10 (exactly: a power of two), give the same branches with the same
+/// configurations and verdicts, alpha and the sliders (relative to 1 + the largest) within
+/// 2e-15 (measured: 2.2e-16; most are equal to the bit), from [`solve`] and from
+/// [`super::working_fast`]. A margin, stop or bound in absolute units that decided otherwise
+/// at another scale, or a term of the wrong power of length, would show.
+#[test]
+fn the_solvers_do_not_depend_on_the_unit_of_length() {
+    use super::working_fast;
+    let close = |a: &IkBranch, b: &IkBranch, k: f64| {
+        a.config == b.config
+            && a.verdict == b.verdict
+            && (a.alpha - b.alpha).abs() <= 2e-15
+            && (a.rho - b.rho / k).amax() <= 2e-15 * (1.0 + a.rho.amax())
+    };
+    let (mut compared, mut fast) = (0, 0);
+    for (m, _) in as_built_and_opened() {
+        for k in [2f64.powi(-10), 2f64.powi(10)] {
+            let scaled = scaled_machine(&m, k);
+            for p in grid(16) {
+                let (one, other) = (solve(&m, &p), solve(&scaled, &(p * k)));
+                let at = format!("{} x{k}: {p:?}:\n{one:?}\n{other:?}", m.name);
+                assert_eq!(one.len(), other.len(), "{at}");
+                for (a, b) in one.iter().zip(other.iter()) {
+                    assert!(close(a, b, k), "{at}");
+                }
+                compared += one.len();
+                match (working_fast(&m, &p), working_fast(&scaled, &(p * k))) {
+                    (None, None) => {}
+                    (Some(a), Some(b)) if close(&a, &b, k) => fast += 1,
+                    found => panic!("{at}: {found:?}"),
+                }
+            }
+        }
+    }
+    assert!(
+        compared > 100_000 && fast > 1000,
+        "{compared} branches, {fast} fast"
+    );
+}
+
 /// A point whose leg II (or leg III) is stretched to within h = 1e-3 to 1e-5 mm, or fully (h =
 /// 0), or short by rounding noise (the square root's argument -1e-8 mm^2, within
 /// [`crate::tolerance::SQRT_ARG_REL`] L^2 of zero): built from a leg-I posture (alpha, rho1) by
