@@ -913,9 +913,10 @@ fn far_from_the_start() -> (Machine, Vector3<f64>) {
 /// the lanes' certificate: the point is handed over, and its working branch comes from the
 /// cubic all the same. At the point of [`far_from_the_start`] the start is at alpha = -0.12 rad,
 /// 0.9 rad from the working posture, and the first step, about 5 rad long, leaves sin and cos
-/// off the unit circle by more than 0.1; the steps after it settle there, on a posture that passes every other test of the lanes
-/// (the margins, the isolated root, a feasible lower branch), with a branch that is not the
-/// working one. Only that first step's `usable` keeps the lanes from answering with it.
+/// off the unit circle by more than 0.1; the steps after it settle there, on a posture that
+/// passes every other test of the lanes (the margins, the isolated root, a feasible lower
+/// branch), with a branch that is not the working one. Only that first step's `usable` keeps
+/// the lanes from answering with it.
 #[test]
 fn a_first_step_beyond_the_series_is_handed_over() {
     use super::{
@@ -1192,10 +1193,7 @@ fn postures_at_a_double_root_of_eq9() {
     for k in [1.0, 2f64.powi(-10), 2f64.powi(10)] {
         let (mut decided, mut extended) = (0, 0);
         for m0 in machines() {
-            let m = Machine {
-                module: scaled_module(&m0.module, k),
-                ..m0.clone()
-            };
+            let m = scaled_machine(&m0, k);
             for (c0, p0) in double_root_points(&m0) {
                 let u0 = p0.x + m0.module.dx1;
                 for rel in [1e-6, 1e-9, 1e-12, 1e-14, 0.0, -1e-14, -1e-12, -1e-9, -1e-6] {
