@@ -922,33 +922,10 @@ mod tests {
     #[test]
     fn the_same_machine_scaled_is_accepted_or_refused_alike() {
         let scaled = |k: f64, r1_rel: f64, d2_rel: f64| {
-            let mut m = Machine::default_verne();
+            let mut m = Machine::default_verne().scaled(k);
             let g = &mut m.module;
-            for v in [
-                &mut g.dx1,
-                &mut g.dx2,
-                &mut g.r_big1,
-                &mut g.l1,
-                &mut g.r_big2,
-                &mut g.r4,
-                &mut g.l2,
-                &mut g.l3,
-                &mut m.table.d_a,
-                &mut m.table.d_t,
-                &mut m.tool_length,
-            ] {
-                *v *= k;
-            }
             g.r_small1 = g.r_big1 * (1.0 - r1_rel);
             g.dx2 = g.dx1 + d2_rel * g.l1.max(g.l2).max(g.l3);
-            for v in m
-                .limits
-                .rho_min
-                .iter_mut()
-                .chain(m.limits.rho_max.iter_mut())
-            {
-                *v *= k;
-            }
             Machine::from_toml_str(&m.to_toml(), "scaled")
         };
         for k in [1e-2, 1.0, 1e2, 1e4] {

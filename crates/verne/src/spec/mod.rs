@@ -68,4 +68,37 @@ impl Machine {
         Machine::from_toml_str(DEFAULT_MACHINE_TOML, "<default>")
             .expect("the embedded default machine file is valid (tested)")
     }
+
+    /// The machine with every length times `k`: the module's, the strokes' limits, the table's
+    /// and the tool's (angles unchanged). For the tests of scale: with k a power of two, every
+    /// equation scales exactly.
+    #[cfg(test)]
+    pub(crate) fn scaled(&self, k: f64) -> Machine {
+        let mut m = self.clone();
+        m.module = self.module.scaled(k);
+        m.limits.rho_min = self.limits.rho_min.map(|r| r * k);
+        m.limits.rho_max = self.limits.rho_max.map(|r| r * k);
+        m.table.d_a *= k;
+        m.table.d_t *= k;
+        m.tool_length *= k;
+        m
+    }
+}
+
+impl ModuleGeometry {
+    /// The module's lengths times `k` (the shape of every equation unchanged).
+    #[cfg(test)]
+    pub(crate) fn scaled(&self, k: f64) -> ModuleGeometry {
+        ModuleGeometry {
+            dx1: self.dx1 * k,
+            dx2: self.dx2 * k,
+            r_big1: self.r_big1 * k,
+            r_small1: self.r_small1 * k,
+            l1: self.l1 * k,
+            r_big2: self.r_big2 * k,
+            r4: self.r4 * k,
+            l2: self.l2 * k,
+            l3: self.l3 * k,
+        }
+    }
 }

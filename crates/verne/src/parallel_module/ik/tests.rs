@@ -12,7 +12,7 @@ use crate::machine::transforms::tool_pose_eq26;
 use crate::parallel_module::branches::Config;
 use crate::parallel_module::equations::ModulePose;
 use crate::selftest::hard_sets::random_geometries;
-use crate::spec::{Machine, ModuleGeometry};
+use crate::spec::Machine;
 use crate::tolerance::NEWTON_STEP_STOP;
 use nalgebra::Vector3;
 use std::f64::consts::{PI, TAU};
@@ -168,16 +168,6 @@ fn a_point_gets_the_same_bits_alone_and_side_by_side() {
     }
 }
 
-/// `m` with every length times `k`: the module's (see [`scaled_module`]) and the strokes'
-/// limits.
-fn scaled_machine(m: &Machine, k: f64) -> Machine {
-    let mut scaled = m.clone();
-    scaled.module = scaled_module(&m.module, k);
-    scaled.limits.rho_min = m.limits.rho_min.map(|r| r * k);
-    scaled.limits.rho_max = m.limits.rho_max.map(|r| r * k);
-    scaled
-}
-
 /// The solvers do not depend on the unit of length: each point of a 16^3 grid on five
 /// machines, as built and with their limits opened, and the same point on the machine scaled
 /// by 2^-10 and by 2^10 (exactly: a power of two), give the same branches with the same
@@ -202,7 +192,7 @@ fn the_solvers_do_not_depend_on_the_unit_of_length() {
     let (mut compared, mut fast, mut modes) = (0, 0, 0);
     for (m, _) in as_built_and_opened() {
         for k in [2f64.powi(-10), 2f64.powi(10)] {
-            let scaled = scaled_machine(&m, k);
+            let scaled = m.scaled(k);
             for p in grid(16) {
                 let (one, other) = (solve(&m, &p), solve(&scaled, &(p * k)));
                 let at = format!("{} x{k}: {p:?}:\n{one:?}\n{other:?}", m.name);
@@ -569,21 +559,6 @@ fn moved(l: &Leg1, da: f64, dr: f64) -> Leg1 {
     }
 }
 
-/// The module's lengths times `k` (the shape of every equation unchanged).
-fn scaled_module(g: &ModuleGeometry, k: f64) -> ModuleGeometry {
-    ModuleGeometry {
-        dx1: g.dx1 * k,
-        dx2: g.dx2 * k,
-        r_big1: g.r_big1 * k,
-        r_small1: g.r_small1 * k,
-        l1: g.l1 * k,
-        r_big2: g.r_big2 * k,
-        r4: g.r4 * k,
-        l2: g.l2 * k,
-        l3: g.l3 * k,
-    }
-}
-
 /// Distance of `l` from the root `root`: (rad, mm).
 fn off(l: &Leg1, root: &Leg1) -> (f64, f64) {
     ((l.alpha - root.alpha).abs(), (l.rho1 - root.rho1).abs())
@@ -663,7 +638,7 @@ fn leg1_steps_predict_the_error_they_leave() {
     for k in [1.0, 1e-2, 1e2] {
         let mut worst = [[0.0f64; 2]; 4];
         for (m, roots) in &roots {
-            let g = scaled_module(&m.module, k);
+            let g = m.module.scaled(k);
             for (p, root) in roots {
                 let (p, root) = (
                     p * k,
@@ -1213,7 +1188,7 @@ fn postures_at_a_double_root_of_eq9() {
     for k in [1.0, 2f64.powi(-10), 2f64.powi(10)] {
         let (mut decided, mut extended) = (0, 0);
         for m0 in machines() {
-            let m = scaled_machine(&m0, k);
+            let m = m0.scaled(k);
             for (c0, p0) in double_root_points(&m0) {
                 let u0 = p0.x + m0.module.dx1;
                 for rel in [1e-6, 1e-9, 1e-12, 1e-14, 0.0, -1e-14, -1e-12, -1e-9, -1e-6] {
