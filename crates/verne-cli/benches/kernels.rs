@@ -50,6 +50,7 @@ use verne::workspace::{self, Of, Outcome, PAPER_LAMBDA_BOUNDS, WorkspaceOptions}
 use verne_cli::engine::pipeline::RUN_ROWS;
 use verne_cli::input::verify_files::{JointReader, PathReader};
 use verne_cli::table::CsvSource;
+use verne_cli::toolpath::csv::CsvToolpath;
 
 // ------------------------------------------------------------------------------ parameters
 
@@ -688,7 +689,8 @@ impl Fixture {
                 .expect("in-memory CSV")
         };
         let mut joints = JointReader::new(src(&self.verify_joints_csv, "joints")).expect("joints");
-        let mut path = PathReader::from_csv(src(&self.verify_path_csv, "path")).expect("path");
+        let toolpath = CsvToolpath::new(src(&self.verify_path_csv, "path"), false).expect("path");
+        let mut path = PathReader::new(Box::new(toolpath), nalgebra::Vector3::zeros());
         let mut findings = 0u64;
         let summary = verify(
             &self.machine,

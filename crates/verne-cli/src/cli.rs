@@ -132,7 +132,7 @@ pub struct IkArgs {
     pub output: Option<PathBuf>,
     /// Resample the toolpath at this servo period (1ms, 250us, 0.001s) from its feeds: one row
     /// per period, as LinuxCNC's halstreamer plays them; CSV output gains a `t` column (s).
-    #[arg(long, value_name = "PERIOD", value_parser = crate::input::resample::parse_period)]
+    #[arg(long, value_name = "PERIOD", value_parser = crate::toolpath::resample::parse_period)]
     pub period: Option<f64>,
     /// The machine's rapid rate (mm/min) that times rapid moves under --period.
     #[arg(long, value_name = "MM_MIN", value_parser = parse_positive, requires = "period")]
@@ -223,7 +223,7 @@ pub enum MachineCommand {
 }
 
 pub use crate::arg_values::*;
-use crate::input::cl::ReadOptions;
+use crate::toolpath::open::ReadOptions;
 
 /// How a toolpath is read and where the part sits (`verne ik`, `verne verify --path`).
 #[derive(Debug, Clone, Args)]
@@ -467,7 +467,7 @@ pub struct VerifyArgs {
     #[arg(long, value_name = "LIST", requires = "recording")]
     pub columns: Option<String>,
     /// The servo period of a recording (1ms, 250us, 0.001s): sample k is at k x period.
-    #[arg(long, value_name = "PERIOD", requires = "recording", value_parser = crate::input::resample::parse_period)]
+    #[arg(long, value_name = "PERIOD", requires = "recording", value_parser = crate::toolpath::resample::parse_period)]
     pub period: Option<f64>,
 }
 

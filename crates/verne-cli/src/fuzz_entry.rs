@@ -4,7 +4,6 @@
 
 use std::io::Cursor;
 
-use crate::engine::machine_rows::{MachineIk, OrientationColumns};
 use crate::engine::module_rows::{ModuleFkAll, ModuleFkWorking, ModuleIkAll, ModuleIkWorking};
 use crate::engine::pipeline::{self, Units};
 use crate::table::{CsvSource, Sink};
@@ -39,25 +38,28 @@ pub fn csv_rows(data: &[u8], fk: bool) {
 /// CSV tool poses (x,y,z with i,j,k or phi1,phi2) through the machine inverse kinematics along
 /// a path (`verne ik` on a toolpath), every branch (`--all`) and the followed one.
 pub fn csv_tool_rows(data: &[u8]) {
-    for orientation in [OrientationColumns::Axis, OrientationColumns::Angles] {
-        for all in [true, false] {
-            let Ok(mut source) =
-                CsvSource::from_reader(Box::new(Cursor::new(data.to_vec())), "fuzz")
-            else {
-                return;
-            };
-            let mut sink = Sink::from_writer(Box::new(std::io::sink()), "sink");
-            let machine = Machine::default_verne();
-            let tool_length = machine.tool_length;
-            let mut job = MachineIk::new(
-                machine,
-                tool_length,
-                orientation,
-                all,
-                FirstRowChoice::default(),
-            );
-            let _ = pipeline::run(&mut job, &mut source, &mut sink, Units::default(), &|_| {});
-        }
+    use crate::follow::{FollowOptions, Follower};
+    use crate::toolpath::csv::CsvToolpath;
+    for all in [true, false] {
+        let Ok(source) = CsvSource::from_reader(Box::new(Cursor::new(data.to_vec())), "fuzz")
+        else {
+            return;
+        };
+        let Ok(mut path) = CsvToolpath::new(source, false) else {
+            return;
+        };
+        let machine = Machine::default_verne();
+        let mut follower = Follower::new(FollowOptions {
+            tool_length: machine.tool_length,
+            machine,
+            offset: nalgebra::Vector3::zeros(),
+            all,
+            first: FirstRowChoice::default(),
+            seed_theta2: None,
+            period: None,
+        });
+        let mut sink = crate::follow::write::CsvRows::to_writer(Box::new(std::io::sink()), all);
+        let _ = crate::follow::run(&mut path, &mut follower, &mut sink, &|_| {});
     }
 }
 
@@ -77,7 +79,9 @@ pub fn apt_file(data: &[u8]) {
 /// CLI's readings of it as a tool-centre program and as a joint program (default words, and
 /// the tool-vector form), which must end in rows or an error, never a panic.
 pub fn gcode_file(data: &[u8]) {
-    use crate::input::gcode::{JointProgram, TcpRows};
+    use crate::input::gcode::JointProgram;
+    use crate::toolpath::ToolpathSource;
+    use crate::toolpath::gcode::TcpToolpath;
     use verne::spec::gcode::{GcodeOrientation, GcodeWords};
     use verne::verify::RowSource;
     verne_gcode::fuzz_read(data);
@@ -93,10 +97,11 @@ pub fn gcode_file(data: &[u8]) {
             verne_gcode::Reader::new(input, options).ok()
         };
         if let Some(reader) = open() {
-            let mut rows = TcpRows::new(reader, "fuzz.ngc", &words);
+            let mut rows = TcpToolpath::new(reader, "fuzz.ngc", &words);
+            let mut row = crate::toolpath::PoseRow::default();
             for _ in 0..100_000 {
-                match rows.next_pose() {
-                    Some(Ok(p)) => assert!(p.tip.iter().all(|v| v.is_finite()), "tip"),
+                match rows.next_row(&mut row) {
+                    Ok(true) => assert!(row.tip.iter().all(|v| v.is_finite()), "tip"),
                     _ => break,
                 }
             }

@@ -52,12 +52,13 @@ pub mod cli;
 pub mod cmd;
 pub mod engine;
 pub mod error;
+pub mod follow;
 pub mod fuzz_entry;
 pub mod input;
 pub mod plot;
-pub mod post;
 pub mod report;
 pub mod table;
+pub mod toolpath;
 
 use std::process::ExitCode;
 

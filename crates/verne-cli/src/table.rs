@@ -11,17 +11,25 @@ use csv::ByteRecord;
 use verne::error::shown;
 
 use crate::error::VerneError;
-use crate::input::rows::{FieldRow, FieldRows};
 
-/// A table input with a header: CSV text (a file or stdin), or the rows of a reader of another
-/// format in the same columns ([`FieldRows`]).
+/// A table input with a header: CSV text (a file or stdin), or numbers given on the command
+/// line (`--pose`, `--joints`, `--machine-joints`), which stay numbers.
 pub struct CsvSource {
     records: Records,
     name: String,
     headers: ByteRecord,
-    /// A column that holds each row's line in the file the rows come from (a CL file's rows):
-    /// messages then name that line rather than the row's place in the table.
-    line_column: Option<usize>,
+}
+
+/// One row of a table as read: a CSV record's cells, or the numbers of a command-line row.
+#[derive(Debug, Default, Clone)]
+pub struct TableRow {
+    /// The CSV record (its cells and its place in the file).
+    pub record: ByteRecord,
+    /// The row's numbers, in the columns' order, when the row was given as numbers; empty for
+    /// CSV text.
+    pub numbers: Vec<f64>,
+    /// The row's line: in the CSV text, or its place among the command line's rows (1-based).
+    pub line: u64,
 }
 
 /// Where the records of a [`CsvSource`] come from.
@@ -31,10 +39,10 @@ enum Records {
         /// The record as read, before its fields are trimmed into the caller's record.
         raw: ByteRecord,
     },
-    Fields {
-        rows: Box<dyn FieldRows>,
-        /// Scratch space for formatting a field.
-        text: Vec<u8>,
+    Numbers {
+        rows: std::vec::IntoIter<Vec<f64>>,
+        /// The number of rows read so far.
+        read: u64,
     },
 }
 
@@ -93,27 +101,21 @@ impl CsvSource {
             },
             name: name.to_string(),
             headers: headers_clean,
-            line_column: None,
         };
         src.check_duplicate_headers()?;
         Ok(src)
     }
 
-    /// The rows of a reader of another format, record by record (no CSV text in between);
-    /// messages take each row's line from its `line` column. `name` is the reader's input.
-    pub fn from_rows(rows: Box<dyn FieldRows>, name: &str) -> CsvSource {
-        let headers = ByteRecord::from(rows.header().to_vec());
-        let mut src = CsvSource {
-            records: Records::Fields {
-                rows,
-                text: Vec::with_capacity(32),
+    /// Rows of numbers given on the command line, under the column names `header`.
+    pub fn from_numbers(header: &[&str], rows: Vec<Vec<f64>>, name: &str) -> CsvSource {
+        CsvSource {
+            records: Records::Numbers {
+                rows: rows.into_iter(),
+                read: 0,
             },
             name: name.to_string(),
-            headers,
-            line_column: None,
-        };
-        src.line_column = src.column("line");
-        src
+            headers: ByteRecord::from(header.to_vec()),
+        }
     }
 
     fn check_duplicate_headers(&self) -> Result<(), VerneError> {
@@ -140,15 +142,9 @@ impl CsvSource {
         &self.name
     }
 
-    /// Takes each row's line in messages from the column `name` (see [`line_of`]).
-    pub fn with_line_column(mut self, name: &str) -> CsvSource {
-        self.line_column = self.column(name);
-        self
-    }
-
-    /// The column that holds each row's line in its original file, if any.
-    pub fn line_column(&self) -> Option<usize> {
-        self.line_column
+    /// The name of column `i`, for a message.
+    pub fn header_name(&self, i: usize) -> String {
+        shown(self.headers.get(i).unwrap_or(b""))
     }
 
     pub fn headers(&self) -> &ByteRecord {
@@ -201,16 +197,35 @@ impl CsvSource {
         shown(&joined)
     }
 
-    /// Reads the next record into `rec`; false at the end of the input.
-    /// Every field has its surrounding ASCII white space removed.
-    pub fn read(&mut self, rec: &mut ByteRecord) -> Result<bool, VerneError> {
-        let (reader, raw) = match &mut self.records {
-            Records::Text { reader, raw } => (reader, raw),
-            Records::Fields { rows, text } => {
-                return rows
-                    .next_row(&mut FieldRow::new(rec, text))
-                    .map_err(|e| VerneError::io(&self.name, e));
+    /// Reads the next row; false at the end of the input. Every field of CSV text has its
+    /// surrounding ASCII white space removed.
+    pub fn read_row(&mut self, row: &mut TableRow) -> Result<bool, VerneError> {
+        match &mut self.records {
+            Records::Numbers { rows, read } => {
+                let Some(numbers) = rows.next() else {
+                    return Ok(false);
+                };
+                *read += 1;
+                row.record.clear();
+                row.numbers = numbers;
+                row.line = *read;
+                Ok(true)
             }
+            Records::Text { .. } => {
+                row.numbers.clear();
+                let more = self.read(&mut row.record)?;
+                row.line = row.record.position().map_or(0, |p| p.line());
+                Ok(more)
+            }
+        }
+    }
+
+    /// Reads the next record of CSV text into `rec`; false at the end of the input (and for
+    /// rows of numbers, which [`CsvSource::read_row`] reads). Every field has its surrounding
+    /// ASCII white space removed.
+    pub fn read(&mut self, rec: &mut ByteRecord) -> Result<bool, VerneError> {
+        let Records::Text { reader, raw } = &mut self.records else {
+            return Ok(false);
         };
         match reader.read_byte_record(raw) {
             Ok(true) => {}
@@ -848,18 +863,6 @@ impl<R: Read> Read for LfLines<R> {
 
 /// Appended to a missing-columns message: the input shapes verne reads (docs/csv.md).
 const INPUT_SHAPES: &str = ". Inputs verne reads (column names in any case): tool poses x,y,z with i,j,k or phi1,phi2; platform points xp,yp,zp; machine joints rho1,rho2,rho3,theta1,theta2; slider rows rho1,rho2,rho3";
-
-/// The line a record comes from: the value of `line_column` when the rows come from another
-/// file (a CL file read as CSV), else the record's line in the CSV text.
-pub fn line_of(record: &ByteRecord, line_column: Option<usize>) -> Option<u64> {
-    match line_column {
-        Some(c) => record
-            .get(c)
-            .and_then(|f| std::str::from_utf8(f).ok())
-            .and_then(|f| f.parse().ok()),
-        None => record.position().map(|p| p.line()),
-    }
-}
 
 #[cfg(test)]
 pub(crate) mod tests {

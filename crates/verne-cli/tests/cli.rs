@@ -467,11 +467,13 @@ fn prefer_is_honoured_where_a_vertical_start_decides_and_theta2_does_not_swing()
             );
         }
     }
-    // The same file on stdin is read once: no look-ahead, theta2 starts at 0 (documented).
+    // The same file on stdin is read once and looked ahead in the same buffer: the same joints.
     let example = std::fs::read_to_string(format!("{}/data/example.cl", common::ROOT)).unwrap();
-    let out = run(&["ik", "--prefer", "orientation2"], Some(&example));
-    let (h, rows) = table(&out);
-    assert_eq!(rows[0][col(&h, "theta2")], "0");
+    let piped = run(&["ik", "--prefer", "orientation2"], Some(&example));
+    let named = run(&["ik", "--prefer", "orientation2", "data/example.cl"], None);
+    assert_eq!(piped.status.code(), Some(0));
+    assert_eq!(table(&piped).1, table(&named).1);
+    assert_ne!(table(&piped).1[0][col(&table(&piped).0, "theta2")], "0");
 }
 
 /// A joint list (halstreamer, G-code) stops at a row it cannot solve: to a file nothing is
@@ -503,5 +505,70 @@ fn a_stopped_joint_list_on_stdout_is_called_incomplete() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!err.contains("incomplete"), "{err}");
     assert!(!file.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Every input is opened once: a named pipe or `/dev/stdin` gives the same output as the file
+/// (a CL file, a tool-centre program, a CSV toolpath, and both inputs of `verify`), never a hang
+/// or a second read.
+#[test]
+fn a_named_pipe_reads_as_the_file_does() {
+    let dir = std::env::temp_dir().join(format!("verne-fifo-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let fifo = |name: &str, from: &str| -> (std::path::PathBuf, std::thread::JoinHandle<()>) {
+        let p = dir.join(name);
+        let _ = std::fs::remove_file(&p);
+        let made = std::process::Command::new("mkfifo")
+            .arg(&p)
+            .status()
+            .unwrap();
+        assert!(made.success());
+        let bytes = std::fs::read(format!("{}/{from}", common::ROOT)).unwrap();
+        let q = p.clone();
+        let writer = std::thread::spawn(move || {
+            let _ = std::fs::write(&q, bytes);
+        });
+        (p, writer)
+    };
+    for file in [
+        "data/example.cl",
+        "data/example-tcp.ngc",
+        "data/platform_path.csv",
+    ] {
+        let named = run(&["ik", file], None);
+        let (p, writer) = fifo("input", file);
+        let piped = run(&["ik", p.to_str().unwrap()], None);
+        writer.join().unwrap();
+        assert_eq!(piped.status.code(), named.status.code(), "{file}");
+        assert_eq!(piped.stdout, named.stdout, "{file}");
+        let text = std::fs::read_to_string(format!("{}/{file}", common::ROOT)).unwrap();
+        let stdin = run(&["ik", "/dev/stdin"], Some(&text));
+        assert_eq!(stdin.stdout, named.stdout, "{file} through /dev/stdin");
+    }
+    let named = run(
+        &[
+            "verify",
+            "--joints",
+            "data/example-post.ngc",
+            "--path",
+            "data/example-tcp.ngc",
+        ],
+        None,
+    );
+    let (j, wj) = fifo("joints", "data/example-post.ngc");
+    let (p, wp) = fifo("path", "data/example-tcp.ngc");
+    let piped = run(
+        &[
+            "verify",
+            "--joints",
+            j.to_str().unwrap(),
+            "--path",
+            p.to_str().unwrap(),
+        ],
+        None,
+    );
+    wj.join().unwrap();
+    wp.join().unwrap();
+    assert_eq!(piped.status.code(), named.status.code());
     let _ = std::fs::remove_dir_all(&dir);
 }

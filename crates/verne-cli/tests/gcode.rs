@@ -274,7 +274,8 @@ fn one_kind_of_program_is_never_read_as_the_other() {
     assert_eq!(v.status.code(), Some(2));
     let e = stderr(&v);
     assert!(
-        e.contains("are not words of a tool-centre program") && e.contains("line 6"),
+        e.contains("are not words of a tool-centre program")
+            && e.contains("data/example-post.ngc:6: "),
         "{e}"
     );
     // An incomplete first pose, on stdin (sniffed as G-code, not CSV).
@@ -282,7 +283,7 @@ fn one_kind_of_program_is_never_read_as_the_other() {
     assert_eq!(v.status.code(), Some(2));
     let e = stderr(&v);
     assert!(
-        e.contains("<stdin>") && e.contains("line 2") && e.contains("A C not given"),
+        e.contains("<stdin>:2: ") && e.contains("A C not given"),
         "{e}"
     );
     // What the reader does not evaluate, with its line and column.
@@ -290,7 +291,7 @@ fn one_kind_of_program_is_never_read_as_the_other() {
     assert_eq!(v.status.code(), Some(2));
     let e = stderr(&v);
     assert!(
-        e.contains("line 2, column 5") && e.contains("parameters"),
+        e.contains("<stdin>:2: column 5: ") && e.contains("parameters"),
         "{e}"
     );
 }

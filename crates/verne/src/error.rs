@@ -54,20 +54,29 @@ impl std::error::Error for MachineError {}
 /// Longest piece of input quoted in a message (characters).
 pub const MESSAGE_CHARS: usize = 120;
 
-/// Input bytes as they may be quoted in a message: invalid UTF-8 escaped, long text shortened.
+/// Text with its control characters (NUL, BEL, ESC, ...) escaped (`\u{1b}`), so that input
+/// quoted in a message is never echoed raw to a terminal. Every message that quotes input
+/// goes through it ([`shown`] too).
+pub fn escape_controls(text: &str) -> String {
+    if !text.chars().any(char::is_control) {
+        return text.to_string();
+    }
+    text.chars()
+        .map(|c| {
+            if c.is_control() {
+                c.escape_default().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
+}
+
+/// Input bytes as they may be quoted in a message: control characters and invalid UTF-8
+/// escaped, long text shortened.
 pub fn shown(bytes: &[u8]) -> String {
     let text = match std::str::from_utf8(bytes) {
-        // Control characters (NUL, ESC, ...) escaped: input is never echoed raw to a terminal.
-        Ok(t) => t
-            .chars()
-            .map(|c| {
-                if c.is_control() {
-                    c.escape_default().to_string()
-                } else {
-                    c.to_string()
-                }
-            })
-            .collect(),
+        Ok(t) => escape_controls(t),
         Err(_) => bytes.escape_ascii().to_string(),
     };
     if text.chars().count() > MESSAGE_CHARS {

@@ -28,18 +28,14 @@ pub fn run(args: &FkArgs) -> Result<u8, VerneError> {
     let u = units(&args.common);
     let source = if !args.joints.is_empty() {
         inline_source(
-            "rho1,rho2,rho3",
-            &args.joints.iter().map(|j| j.to_vec()).collect::<Vec<_>>(),
-        )?
+            &["rho1", "rho2", "rho3"],
+            args.joints.iter().map(|j| j.to_vec()).collect(),
+        )
     } else if !args.machine_joints.is_empty() {
         inline_source(
-            "rho1,rho2,rho3,theta1,theta2",
-            &args
-                .machine_joints
-                .iter()
-                .map(|j| j.to_vec())
-                .collect::<Vec<_>>(),
-        )?
+            &["rho1", "rho2", "rho3", "theta1", "theta2"],
+            args.machine_joints.iter().map(|j| j.to_vec()).collect(),
+        )
     } else {
         CsvSource::open(args.input.as_deref())?
     };

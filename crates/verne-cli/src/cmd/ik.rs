@@ -1,21 +1,30 @@
-//! `verne ik`: tool poses (workpiece frame) -> machine joints, or platform points -> joints of
-//! the parallel module (IFToMM 2007, section V), from CSV or a CL file.
+//! `verne ik`: tool poses (workpiece frame) -> machine joints along a toolpath, from a CSV, a CL
+//! file, a tool-centre G-code program or the command line; or platform points -> joints of the
+//! parallel module (IFToMM 2007, section V).
 
-use crate::engine::machine_rows::{MachineIk, OrientationColumns};
+use std::path::Path;
+
 use crate::engine::module_rows::{ModuleIkAll, ModuleIkWorking};
 use crate::error::VerneError;
-use crate::table::{CsvSource, parse_number};
-use std::sync::{Arc, Mutex};
-
-use verne::machine::orientation::{ToolAngles, ToolOrientation};
-use verne::machine::{FirstRowChoice, PathState, first_decided_theta2};
+use crate::follow::write::{CsvRows, GcodeProgram, Halstreamer};
+use crate::follow::{FollowOptions, Follower, RowSink};
+use crate::table::CsvSource;
+use crate::toolpath::columns::TableKind;
+use crate::toolpath::csv::CsvToolpath;
+use crate::toolpath::gcode::TcpToolpath;
+use crate::toolpath::inline::InlineToolpath;
+use crate::toolpath::lookahead::Lookahead;
+use crate::toolpath::open::{Format, Input};
+use crate::toolpath::resample::Resampler;
+use crate::toolpath::{ReaderReport, ToolpathSource};
+use verne::machine::{FirstRowChoice, first_decided_theta2};
 use verne::spec::Machine;
 
-use super::{Mechanism, inline_source, load_mechanism, refuse_for_glider, run_rows, units};
-use crate::cli::{IkArgs, OutputFormat, Prefer};
-use crate::input::cl::{ClRows, PathInput, open_path_input, report_summary};
-use crate::input::gcode::TcpRows;
-use crate::input::resample::{CsvPoses, Resampler};
+use super::{
+    EXIT_OK, EXIT_ROWS_FAILED, Mechanism, inline_source, load_mechanism, progress_bar,
+    refuse_for_glider, report, run_rows, units,
+};
+use crate::cli::{IkArgs, InputFormat, OutputFormat, Prefer};
 
 pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
     let machine = match load_mechanism(args.common.machine.as_deref())? {
@@ -37,239 +46,226 @@ pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
         }
         Mechanism::Verne(m) => m,
     };
-    let mut u = units(&args.common);
-    u.halstreamer = args.format == OutputFormat::Halstreamer;
-    if args.format == OutputFormat::Gcode {
+    let program = match args.format {
+        OutputFormat::Csv => None,
+        OutputFormat::Halstreamer => Some("halstreamer"),
+        OutputFormat::Gcode => Some("gcode"),
+    };
+    if let Some(format) = program {
         if args.common.radians || args.common.precision.is_some() {
+            return Err(VerneError::Usage(format!(
+                "--format {format} writes degrees and mm as LinuxCNC reads them: drop --radians and --precision"
+            )));
+        }
+        if args.all {
+            return Err(VerneError::Usage(format!(
+                "--format {format} writes one joint row per pose; it cannot be combined with --all"
+            )));
+        }
+    }
+    crate::arg_values::spatial(&args.pose, "--pose", "XP,YP,ZP").map_err(VerneError::Usage)?;
+    if !args.pose.is_empty() {
+        let source = inline_source(
+            &["xp", "yp", "zp"],
+            args.pose.iter().map(|p| p.to_vec()).collect(),
+        );
+        return module_ik(args, machine, source, program);
+    }
+    let source: Box<dyn ToolpathSource> = if !args.tool.is_empty() {
+        if args.period.is_some() {
             return Err(VerneError::Usage(
-                "--format gcode writes degrees and mm with its own precision: drop --radians and --precision".into(),
+                "--period times each move by its feed, and --tool poses have none: give the path as a CSV with a `feed` column, a CL file or a program".into(),
             ));
         }
-        u.gcode = Some(machine.gcode);
-    }
-    let format_name = if u.halstreamer {
-        "halstreamer"
+        Box::new(InlineToolpath::new(&args.tool))
     } else {
-        "gcode"
+        let force = args.input_format.map(|f| match f {
+            InputFormat::Csv => Format::Csv,
+            InputFormat::Apt => Format::Cl,
+            InputFormat::Gcode => Format::Gcode,
+        });
+        let options = args.part.read_options(&machine.gcode);
+        let input = Input::open(
+            args.input.as_deref(),
+            force,
+            &[Format::Csv, Format::Cl, Format::Gcode],
+        )?;
+        match input.format {
+            Format::Cl => Box::new(input.into_cl(options.cl)?),
+            Format::Gcode => {
+                let name = input.name.clone();
+                let reader = input.into_gcode(options.gcode)?;
+                Box::new(TcpToolpath::new(reader, &name, &machine.gcode))
+            }
+            Format::Csv => {
+                let csv = input.into_csv()?;
+                let kind = TableKind::detect(|c| csv.column(c).is_some())
+                    .map_err(|m| VerneError::input(csv.name(), Some(1), None, m))?;
+                if kind != TableKind::ToolPoses {
+                    if args.period.is_some() {
+                        return Err(VerneError::Usage(
+                            "--period resamples a toolpath of tool poses (x,y,z with i,j,k or phi1,phi2), not platform points".into(),
+                        ));
+                    }
+                    return module_ik(args, machine, csv, program);
+                }
+                if args.period.is_some()
+                    && csv.column("feed").is_none()
+                    && csv.column("dt").is_none()
+                {
+                    return Err(VerneError::input(
+                        csv.name(),
+                        Some(1),
+                        None,
+                        "--period times each move by its feed: a CSV toolpath needs a `feed` column (mm/min) or a `dt` column (s)",
+                    ));
+                }
+                Box::new(CsvToolpath::new(csv, args.common.radians)?)
+            }
+        }
     };
-    if u.every_row_needed() && args.all {
+    follow_path(args, machine, source, program)
+}
+
+/// `verne ik` on platform points: the parallel module alone.
+fn module_ik(
+    args: &IkArgs,
+    machine: Machine,
+    source: CsvSource,
+    program: Option<&str>,
+) -> Result<u8, VerneError> {
+    if args.part.offset.is_some() {
+        return Err(VerneError::Usage(
+            "--offset places tool poses (x,y,z): platform points (xp,yp,zp) are already in the machine's frame".into(),
+        ));
+    }
+    if let Some(format) = program {
         return Err(VerneError::Usage(format!(
-            "--format {format_name} writes one joint row per pose; it cannot be combined with --all"
+            "--format {format} writes machine joints: give tool poses (x,y,z with i,j,k or phi1,phi2), not platform points"
         )));
     }
+    let output = args.output.as_ref();
+    let u = units(&args.common);
+    if args.all {
+        run_rows("ik", &mut ModuleIkAll { machine }, source, output, u)
+    } else {
+        run_rows("ik", &mut ModuleIkWorking { machine }, source, output, u)
+    }
+}
+
+/// `verne ik` on a toolpath: resampled at the servo period when asked, read ahead to the first
+/// decided orientation, followed, written.
+fn follow_path(
+    args: &IkArgs,
+    machine: Machine,
+    source: Box<dyn ToolpathSource>,
+    program: Option<&str>,
+) -> Result<u8, VerneError> {
     let tool_length = args.tool_length.unwrap_or(machine.tool_length);
-    let cl_summary;
-    let gcode_summary;
-    let mut travel = None;
-    crate::arg_values::spatial(&args.pose, "--pose", "XP,YP,ZP").map_err(VerneError::Usage)?;
-    let (source, summaries) = open_source(args, &machine)?;
-    (cl_summary, gcode_summary) = summaries;
-    let source = match (args.period, source) {
-        // A program's poses straight from its reader, angle words and all.
-        (Some(period), Source::Program(rows, name)) => {
-            let rows = Resampler::new(rows, period, args.rapid, args.common.radians);
-            CsvSource::from_rows(Box::new(rows), &name)
-        }
-        (None, program @ Source::Program(..)) => program.into_rows(),
-        (Some(period), Source::Csv(source)) => {
-            if source.column("xp").is_some() && source.column("x").is_none() {
-                return Err(VerneError::Usage(
-                    "--period resamples a toolpath of tool poses (x,y,z with i,j,k or phi1,phi2), not platform points".into(),
-                ));
-            }
-            let name = source.name().to_string();
-            let poses = CsvPoses::new(source, args.common.radians)?;
-            let rows = Resampler::new(Box::new(poses), period, args.rapid, args.common.radians);
-            CsvSource::from_rows(Box::new(rows), &name)
-        }
-        (None, Source::Csv(source)) => source,
-    };
     let offset = args.part.offset();
-    let has = |c: &str| source.column(c).is_some();
-    let tool_columns = ["x", "y", "z"].iter().all(|c| has(c));
-    let platform_columns = ["xp", "yp", "zp"].iter().all(|c| has(c));
-    let code = match (tool_columns, platform_columns) {
-        (true, true) => {
-            return Err(VerneError::input(
-                source.name(),
-                Some(1),
-                None,
-                "both tool poses (x,y,z) and platform points (xp,yp,zp) are present: keep one (xp,yp,zp is the parallel module alone)",
-            ));
+    let source: Box<dyn ToolpathSource> = match args.period {
+        Some(period) => {
+            let rapid = args.rapid;
+            Box::new(Resampler::new(source, period, rapid))
         }
-        (true, false) => {
-            let orientation = OrientationColumns::detect(has)
-                .map_err(|m| VerneError::input(source.name(), Some(1), None, m))?;
-            let first = match args.prefer {
-                Prefer::SmallestTheta1 => FirstRowChoice::SmallestTheta1,
-                Prefer::Orientation1 => FirstRowChoice::Orientation1,
-                Prefer::Orientation2 => FirstRowChoice::Orientation2,
-            };
-            let machine_for_travel = machine.clone();
-            // A path that starts with the tool vertical: its orientation is decided further on;
-            // look there first, so that --prefer is honoured and theta2 does not swing.
-            let seed = if args.all {
-                None
-            } else {
-                prescan_theta2(args, &machine, tool_length, offset, first)?
-            };
-            let mut job = MachineIk::new(machine, tool_length, orientation, args.all, first);
-            job.offset = offset;
-            job.travel.period = args.period;
-            if let Some(theta2) = seed {
-                job.state = PathState::with_theta2(first, theta2);
-            }
-            let code = run_rows("ik", &mut job, source, args.output.as_ref(), u)?;
-            // A CAM job (a CL file or a program): where the joints went, against the limits.
-            if (cl_summary.is_some() || gcode_summary.is_some()) && job.travel.rows > 0 {
-                travel = Some(job.travel.line(&machine_for_travel));
-            }
-            code
-        }
-        (false, _) => {
-            if args.part.offset.is_some() {
-                return Err(VerneError::Usage(
-                    "--offset places tool poses (x,y,z): platform points (xp,yp,zp) are already in the machine's frame".into(),
-                ));
-            }
-            if u.every_row_needed() {
-                return Err(VerneError::Usage(format!(
-                    "--format {format_name} writes machine joints: give tool poses (x,y,z with i,j,k or phi1,phi2), not platform points"
-                )));
-            }
-            let output = args.output.as_ref();
-            if args.all {
-                run_rows("ik", &mut ModuleIkAll { machine }, source, output, u)?
-            } else {
-                run_rows("ik", &mut ModuleIkWorking { machine }, source, output, u)?
-            }
+        None => source,
+    };
+    let first = match args.prefer {
+        Prefer::SmallestTheta1 => FirstRowChoice::SmallestTheta1,
+        Prefer::Orientation1 => FirstRowChoice::Orientation1,
+        Prefer::Orientation2 => FirstRowChoice::Orientation2,
+    };
+    // A path that starts with the tool vertical: its orientation is decided further on; read
+    // ahead to there first, so that --prefer is honoured and theta2 does not swing.
+    let (seed_theta2, mut source) = if args.all {
+        (None, Lookahead::read(source, offset, |_| None::<f64>).1)
+    } else {
+        Lookahead::read(source, offset, |poses| {
+            first_decided_theta2(&machine, poses, tool_length, first)
+        })
+    };
+    let output = args.output.as_deref();
+    let u = units(&args.common);
+    let mut sink: Box<dyn RowSink> = match args.format {
+        OutputFormat::Csv => Box::new(CsvRows::create(output, u, args.all)?),
+        OutputFormat::Halstreamer => Box::new(Halstreamer::create(output, u)?),
+        OutputFormat::Gcode => {
+            Box::new(GcodeProgram::create(output, machine.gcode, source.name())?)
         }
     };
-    if let Some((summary, name)) = cl_summary
-        && let Ok(s) = summary.lock()
-    {
-        report_summary("ik", &name, &s, tool_length);
+    let machine_for_travel = machine.clone();
+    let mut follower = Follower::new(FollowOptions {
+        machine,
+        tool_length,
+        offset,
+        all: args.all,
+        first,
+        seed_theta2,
+        period: args.period,
+    });
+    let bar = progress_bar();
+    let tick = |n: u64| {
+        if let Some(b) = &bar {
+            b.set_position(n);
+        }
+    };
+    let started = std::time::Instant::now();
+    let result = crate::follow::run(&mut source, &mut follower, sink.as_mut(), &tick);
+    if let Some(b) = &bar {
+        b.finish_and_clear();
     }
-    if let Some((summary, name)) = gcode_summary
-        && let Ok(s) = summary.lock()
-    {
-        crate::input::gcode::report_summary("ik", &name, &s);
+    if let Err(mut e) = result {
+        sink.discard();
+        if let (Some(_), true, VerneError::Input { message, .. }) =
+            (program, to_stdout(output), &mut e)
+        {
+            // A file is never left partial; a pipe may have received the rows before.
+            message.push_str(
+                "; the rows before it went to stdout as they were solved: that list is incomplete, do not play it (-o FILE writes nothing on such an error)",
+            );
+        }
+        return Err(e);
     }
-    if let Some(line) = travel {
-        sayln!("verne ik: {line}");
+    sink.finish()?;
+    let name = source.name().to_string();
+    let summary = &follower.summary;
+    report("ik", &name, summary);
+    let cam_job = match source.report() {
+        ReaderReport::Cl(s) => {
+            crate::toolpath::cl::report_summary("ik", &name, &s, tool_length);
+            true
+        }
+        ReaderReport::Gcode(s) => {
+            crate::input::gcode::report_summary("ik", &name, &s);
+            true
+        }
+        ReaderReport::Nothing => false,
+    };
+    // A CAM job (a CL file or a program): where the joints went, against the limits.
+    if cam_job && follower.travel.rows > 0 {
+        sayln!("verne ik: {}", follower.travel.line(&machine_for_travel));
     }
-    if u.halstreamer && args.period.is_none() {
+    if args.format == OutputFormat::Halstreamer && args.period.is_none() {
         sayln!(
             "verne ik: note: one row per path point, not per servo period (halstreamer plays one row per period: --period 1ms plays the path at its feeds)"
         );
     }
-    Ok(code)
-}
-
-type Summaries = (
-    Option<(Arc<Mutex<verne_cl::Summary>>, String)>,
-    Option<(Arc<Mutex<verne_gcode::Summary>>, String)>,
-);
-
-/// The input of `verne ik`: a table (inline poses, a CSV, a CL file's rows), or a tool-centre
-/// program's poses (its rows for the row engine, or its poses for `--period`).
-enum Source {
-    Csv(CsvSource),
-    Program(Box<TcpRows>, String),
-}
-
-impl Source {
-    /// The input as a table (a program's poses in the columns of [`TcpRows`]).
-    fn into_rows(self) -> CsvSource {
-        match self {
-            Source::Csv(src) => src,
-            Source::Program(rows, name) => CsvSource::from_rows(rows, &name),
-        }
-    }
-}
-
-fn open_source(args: &IkArgs, machine: &Machine) -> Result<(Source, Summaries), VerneError> {
-    if !args.pose.is_empty() {
-        let rows: Vec<Vec<f64>> = args.pose.iter().map(|p| p.to_vec()).collect();
-        return Ok((Source::Csv(inline_source("xp,yp,zp", &rows)?), (None, None)));
-    }
-    if !args.tool.is_empty() {
-        let rows: Vec<Vec<f64>> = args.tool.iter().map(|p| p.to_vec()).collect();
-        return Ok((
-            Source::Csv(inline_source("x,y,z,i,j,k", &rows)?),
-            (None, None),
-        ));
-    }
-    let options = args.part.read_options(&machine.gcode);
-    Ok(
-        match open_path_input(args.input.as_deref(), args.input_format, &options)? {
-            PathInput::Csv(src) => (Source::Csv(src), (None, None)),
-            PathInput::Gcode(reader, name) => {
-                let rows = TcpRows::new(*reader, &name, &machine.gcode);
-                let summary = Some((rows.summary(), name.clone()));
-                (Source::Program(Box::new(rows), name), (None, summary))
-            }
-            PathInput::Cl(reader, name) => {
-                let rows = ClRows::new(*reader);
-                let summary = Some((rows.summary(), name.clone()));
-                (
-                    Source::Csv(CsvSource::from_rows(Box::new(rows), &name)),
-                    (summary, None),
-                )
-            }
-        },
-    )
-}
-
-/// Rows read ahead at most, looking for the first pose outside the rotary-singularity cone.
-const PRESCAN_ROWS: usize = 100_000;
-
-/// The theta2 that the path's first decided pose needs ([`first_decided_theta2`]), read ahead
-/// in a second pass over the input: a file or the command line's poses (stdin is read once,
-/// so a path on stdin starts at theta2 = 0). Rows that cannot be read end the look-ahead (the
-/// main pass reports them).
-fn prescan_theta2(
-    args: &IkArgs,
-    machine: &Machine,
-    tool_length: f64,
-    offset: nalgebra::Vector3<f64>,
-    first: FirstRowChoice,
-) -> Result<Option<f64>, VerneError> {
-    let rereadable =
-        !args.tool.is_empty() || args.input.as_ref().is_some_and(|p| p.as_os_str() != "-");
-    if !rereadable {
-        return Ok(None);
-    }
-    let mut src = open_source(args, machine)?.0.into_rows();
-    let col = |c: &str| src.column(c);
-    let (Some(x), Some(y), Some(z)) = (col("x"), col("y"), col("z")) else {
-        return Ok(None);
-    };
-    let axis = [col("i"), col("j"), col("k")];
-    let angles = [col("phi1"), col("phi2")];
-    let radians = args.common.radians;
-    let mut rec = csv::ByteRecord::new();
-    let poses = std::iter::from_fn(|| {
-        if !src.read(&mut rec).ok()? {
-            return None;
-        }
-        let num = |i: usize| parse_number(rec.get(i).unwrap_or(b"")).ok();
-        let tip = nalgebra::Vector3::new(num(x)?, num(y)?, num(z)?) + offset;
-        let orientation = match (axis, angles) {
-            ([Some(i), Some(j), Some(k)], _) => {
-                ToolOrientation::Axis(nalgebra::Vector3::new(num(i)?, num(j)?, num(k)?))
-            }
-            (_, [Some(p1), Some(p2)]) => {
-                let a = |v: f64| if radians { v } else { v.to_radians() };
-                ToolOrientation::Angles(ToolAngles {
-                    phi1: a(num(p1)?),
-                    phi2: a(num(p2)?),
-                })
-            }
-            _ => return None,
-        };
-        Some((tip, orientation))
+    let seconds = started.elapsed().as_secs_f64();
+    sayln_verbose!(
+        "verne ik: {name}: {} rows in, {} rows out, {} ok, in {seconds:.3} s ({:.0} rows/s)",
+        summary.input_rows,
+        summary.output_rows,
+        summary.ok_rows,
+        summary.input_rows as f64 / seconds.max(1e-9)
+    );
+    Ok(if summary.all_ok() {
+        EXIT_OK
+    } else {
+        EXIT_ROWS_FAILED
     })
-    .take(PRESCAN_ROWS);
-    Ok(first_decided_theta2(machine, poses, tool_length, first))
+}
+
+/// Whether the output goes to stdout.
+fn to_stdout(output: Option<&Path>) -> bool {
+    output.is_none_or(|p| p.as_os_str() == "-")
 }

@@ -117,27 +117,15 @@ pub fn units(common: &CommonArgs) -> Units {
     Units {
         radians: common.radians,
         decimals: common.precision.map(usize::from),
-        halstreamer: false,
-        gcode: None,
     }
 }
 
-/// The rows given on the command line as an in-memory CSV with `header`.
-pub fn inline_source(header: &str, rows: &[Vec<f64>]) -> Result<CsvSource, VerneError> {
-    let mut text = format!("{header}\n");
-    for r in rows {
-        let cells: Vec<String> = r.iter().map(f64::to_string).collect();
-        text.push_str(&cells.join(","));
-        text.push('\n');
-    }
-    CsvSource::from_reader(
-        Box::new(std::io::Cursor::new(text.into_bytes())),
-        INLINE_SOURCE,
-    )
+/// The rows given on the command line, numbers in the columns `header`.
+pub fn inline_source(header: &[&str], rows: Vec<Vec<f64>>) -> CsvSource {
+    CsvSource::from_numbers(header, rows, INLINE_SOURCE)
 }
 
-/// The name of the rows given on the command line (`--pose`, `--tool`, `--joints`, ...).
-pub const INLINE_SOURCE: &str = "<command line>";
+pub use crate::toolpath::inline::INLINE_SOURCE;
 
 /// Runs a row job from `source` to `output`, with a progress indicator on a terminal, and
 /// prints the summary of rows that were not ok to stderr.
@@ -148,12 +136,7 @@ pub fn run_rows<J: RowJob>(
     output: Option<&PathBuf>,
     units: Units,
 ) -> Result<u8, VerneError> {
-    let delimiter = if units.halstreamer { b' ' } else { b',' };
-    let mut sink = Sink::create_delimited(output.map(PathBuf::as_path), delimiter)?;
-    if let Some(words) = units.gcode {
-        let name = source.name().to_string();
-        sink.wrap(|out| Box::new(crate::post::GcodePost::new(out, words, &name)));
-    }
+    let mut sink = Sink::create(output.map(PathBuf::as_path))?;
     let bar = progress_bar();
     let tick = |n: u64| {
         if let Some(b) = &bar {
@@ -167,17 +150,8 @@ pub fn run_rows<J: RowJob>(
     }
     let summary = match result {
         Ok(s) => s,
-        Err(mut e) => {
+        Err(e) => {
             sink.discard();
-            let to_stdout = output.is_none_or(|p| p.as_os_str() == "-");
-            if let (true, true, VerneError::Input { message, .. }) =
-                (units.every_row_needed(), to_stdout, &mut e)
-            {
-                // A file is never left partial; a pipe may have received the rows before.
-                message.push_str(
-                    "; the rows before it went to stdout as they were solved: that list is incomplete, do not play it (-o FILE writes nothing on such an error)",
-                );
-            }
             return Err(e);
         }
     };
@@ -201,7 +175,7 @@ pub fn run_rows<J: RowJob>(
 
 /// A spinner with the row count and rate, shown only when stderr is a terminal and the run
 /// lasts more than a moment.
-fn progress_bar() -> Option<indicatif::ProgressBar> {
+pub fn progress_bar() -> Option<indicatif::ProgressBar> {
     if !std::io::stderr().is_terminal() {
         return None;
     }
@@ -214,7 +188,7 @@ fn progress_bar() -> Option<indicatif::ProgressBar> {
     Some(bar)
 }
 
-fn report(command: &str, file: &str, s: &RunSummary) {
+pub fn report(command: &str, file: &str, s: &RunSummary) {
     if s.all_ok() {
         return;
     }
@@ -227,8 +201,7 @@ fn report(command: &str, file: &str, s: &RunSummary) {
     );
     for (line, st) in &s.first_failures {
         if file == INLINE_SOURCE {
-            // Line 1 of the inline table is its header: the first pose is on line 2.
-            sayln!("  {file}: row {}: {st}", line.saturating_sub(1));
+            sayln!("  {file}: row {line}: {st}");
         } else {
             sayln!("  {file}:{line}: {st}");
         }

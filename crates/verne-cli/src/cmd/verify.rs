@@ -6,6 +6,7 @@ use crate::input::recording::{DEFAULT_COLUMNS, RecordingReader, parse_columns};
 use crate::input::verify_files::{JointInput, PathReader};
 use crate::report::verify::{short_number, summary_json, summary_text};
 use crate::table::Sink;
+use crate::toolpath::ReaderReport;
 use csv::ByteRecord;
 use verne::verify::contour::{ContourPath, verify_recording};
 use verne::verify::{RowSource, Thresholds, VerifyOptions, verify};
@@ -99,11 +100,12 @@ pub fn run(args: &VerifyArgs) -> Result<u8, VerneError> {
     if let Some(s) = sink {
         s.finish()?;
     }
-    if let Some((name, s)) = path.cl_summary() {
-        crate::input::cl::report_summary("verify", name, s, opt.tool_length);
-    }
-    if let Some((name, s)) = path.gcode_summary() {
-        crate::input::gcode::report_summary("verify", name, &s);
+    match path.report() {
+        ReaderReport::Cl(s) => {
+            crate::toolpath::cl::report_summary("verify", path.name(), &s, opt.tool_length)
+        }
+        ReaderReport::Gcode(s) => crate::input::gcode::report_summary("verify", path.name(), &s),
+        ReaderReport::Nothing => {}
     }
     if let Some((name, s)) = joints.as_ref().and_then(|j| j.gcode_summary()) {
         crate::input::gcode::report_summary("verify", name, s);

@@ -10,7 +10,9 @@ use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use crate::error::VerneError;
-use crate::table::{CellError, CsvSource, Sink, encode_field, format_number, parse_number};
+use crate::table::{
+    CellError, CsvSource, Sink, TableRow, encode_field, format_number, parse_number,
+};
 use verne::error::shown;
 use verne::parallel_module::branches::Verdict;
 
@@ -50,19 +52,6 @@ pub struct Units {
     pub radians: bool,
     /// Fixed decimals for numbers (default: shortest round-trip form).
     pub decimals: Option<usize>,
-    /// `--format halstreamer`: only the joints [`HALSTREAMER_COLUMNS`], no header, and a row
-    /// that is not ok stops the run (a joint list for LinuxCNC's halstreamer cannot skip one).
-    pub halstreamer: bool,
-    /// `--format gcode`: the CSV goes through [`crate::post::GcodePost`] with these words, and
-    /// a row that is not ok stops the run (a joint program cannot skip one either).
-    pub gcode: Option<verne::spec::gcode::GcodeWords>,
-}
-
-impl Units {
-    /// A row that is not ok stops the run: the output is a program for the controller.
-    pub fn every_row_needed(&self) -> bool {
-        self.halstreamer || self.gcode.is_some()
-    }
 }
 
 /// The columns of a halstreamer joint list, in order.
@@ -186,7 +175,7 @@ impl RunSummary {
         self.ok_rows == self.input_rows
     }
 
-    fn count(&mut self, status: &str, line: u64) {
+    pub(crate) fn count(&mut self, status: &str, line: u64) {
         match self.not_ok.iter_mut().find(|(s, _)| s == status) {
             Some((_, n)) => *n += 1,
             None => self.not_ok.push((status.to_string(), 1)),
@@ -198,7 +187,7 @@ impl RunSummary {
 }
 
 struct PendingRow<S> {
-    record: ByteRecord,
+    input: TableRow,
     values: [f64; MAX_INPUTS],
     /// The first input column that is empty or not finite (the row is `invalid_input`).
     invalid: Option<usize>,
@@ -245,14 +234,14 @@ impl<S: Default> Batch<S> {
         while self.filled < rows {
             if self.filled == self.rows.len() {
                 self.rows.push(PendingRow {
-                    record: ByteRecord::new(),
+                    input: TableRow::default(),
                     values: [0.0; MAX_INPUTS],
                     invalid: None,
                     not_a_number: None,
                     solved: S::default(),
                 });
             }
-            if !source.read(&mut self.rows[self.filled].record)? {
+            if !source.read_row(&mut self.rows[self.filled].input)? {
                 break;
             }
             self.filled += 1;
@@ -280,8 +269,6 @@ struct Plan<'a> {
     units: Units,
     delimiter: u8,
     file: &'a str,
-    /// The column of each row's line in its original file (CL input), see `table::line_of`.
-    line_column: Option<usize>,
 }
 
 /// Progress callback: rows done so far.
@@ -307,35 +294,23 @@ pub fn run<J: RowJob>(
     // Output plan: input columns (computed ones replace same-named inputs), then the rest.
     let mut slots = Vec::new();
     let mut header = ByteRecord::new();
-    if units.halstreamer {
-        for name in HALSTREAMER_COLUMNS {
-            let Some(k) = outputs.iter().position(|o| *o == name) else {
-                return Err(VerneError::Usage(format!(
-                    "--format halstreamer writes the machine joints {}; this input gives no `{name}` (use tool poses x,y,z with i,j,k or phi1,phi2)",
-                    HALSTREAMER_COLUMNS.join(",")
-                )));
-            };
-            slots.push(Slot::Computed(k));
+    for (i, h) in source.headers().iter().enumerate() {
+        match outputs
+            .iter()
+            .position(|o| o.as_bytes().eq_ignore_ascii_case(h))
+        {
+            Some(k) => slots.push(Slot::Computed(k)),
+            None => slots.push(Slot::Input(i)),
         }
-    } else {
-        for (i, h) in source.headers().iter().enumerate() {
-            match outputs
-                .iter()
-                .position(|o| o.as_bytes().eq_ignore_ascii_case(h))
-            {
-                Some(k) => slots.push(Slot::Computed(k)),
-                None => slots.push(Slot::Input(i)),
-            }
-            header.push_field(h);
-        }
-        for (k, o) in outputs.iter().enumerate() {
-            if source.column(o).is_none() {
-                slots.push(Slot::Computed(k));
-                header.push_field(o.as_bytes());
-            }
-        }
-        sink.write(&header)?;
+        header.push_field(h);
     }
+    for (k, o) in outputs.iter().enumerate() {
+        if source.column(o).is_none() {
+            slots.push(Slot::Computed(k));
+            header.push_field(o.as_bytes());
+        }
+    }
+    sink.write(&header)?;
     let file = source.name().to_string();
     // Computed cells (numbers, `ok`, reason codes joined by `;`) are written unquoted.
     debug_assert!(matches!(sink.delimiter(), b',' | b' ' | b'\t'));
@@ -347,7 +322,6 @@ pub fn run<J: RowJob>(
         units,
         delimiter: sink.delimiter(),
         file: &file,
-        line_column: source.line_column(),
     };
     stream_batches(job, source, sink, &plan, progress)
 }
@@ -420,8 +394,8 @@ fn process<J: RowJob>(
     // A cell that is not a number stops the run at the first such row.
     if let Some(row) = rows.iter().find(|r| r.not_a_number.is_some()) {
         let k = row.not_a_number.unwrap_or(0);
-        let field = row.record.get(plan.idx[k]).unwrap_or(b"");
-        let line = crate::table::line_of(&row.record, plan.line_column);
+        let field = row.input.record.get(plan.idx[k]).unwrap_or(b"");
+        let line = Some(row.input.line);
         let unit = match (plan.inputs[k].1, plan.units.radians) {
             (false, _) => " (mm)",
             (true, true) => " (radians)",
@@ -442,7 +416,7 @@ fn process<J: RowJob>(
     let mut scratch = Vec::new();
     for (i, row) in rows.iter().enumerate() {
         summary.input_rows += 1;
-        let line = crate::table::line_of(&row.record, plan.line_column).unwrap_or(0);
+        let line = row.input.line;
         let mut writer = RowWriter {
             input: i as u32,
             out_input: &mut batch.out_input,
@@ -469,21 +443,6 @@ fn process<J: RowJob>(
             scratch.clear();
             write_cell(&mut scratch, outcome.status, plan.units);
             let text = String::from_utf8_lossy(&scratch).into_owned();
-            if plan.units.every_row_needed() {
-                let what = if plan.units.halstreamer {
-                    "a halstreamer joint list"
-                } else {
-                    "a joint program"
-                };
-                return Err(VerneError::input(
-                    plan.file,
-                    Some(line),
-                    None,
-                    format!(
-                        "row status `{text}`: {what} cannot leave out a row; fix the path or use CSV output to see every row's status"
-                    ),
-                ));
-            }
             summary.count(&text, line);
         }
     }
@@ -500,12 +459,21 @@ fn process<J: RowJob>(
         .for_each(|(j, bytes)| {
             bytes.clear();
             for o in j * RUN_ROWS..n_out.min((j + 1) * RUN_ROWS) {
-                let input = &rows[out_input[o] as usize].record;
+                let input = &rows[out_input[o] as usize].input;
                 let cells = &out_cells[o * plan.n_computed..(o + 1) * plan.n_computed];
                 for (f, slot) in plan.slots.iter().enumerate() {
                     match *slot {
+                        Slot::Input(i) if !input.numbers.is_empty() => {
+                            // A number given on the command line, as it was given.
+                            if f > 0 {
+                                bytes.push(plan.delimiter);
+                            }
+                            if let Some(v) = input.numbers.get(i) {
+                                let _ = std::io::Write::write_fmt(bytes, format_args!("{v}"));
+                            }
+                        }
                         Slot::Input(i) => {
-                            let field = input.get(i).unwrap_or(b"");
+                            let field = input.record.get(i).unwrap_or(b"");
                             encode_field(bytes, plan.delimiter, f == 0, field);
                         }
                         Slot::Computed(k) => {
@@ -529,8 +497,16 @@ fn parse_row<S>(row: &mut PendingRow<S>, plan: &Plan<'_>) {
     row.invalid = None;
     row.not_a_number = None;
     for (k, &i) in plan.idx.iter().enumerate() {
-        let field = row.record.get(i).unwrap_or(b"");
-        match parse_number(field) {
+        let parsed = if row.input.numbers.is_empty() {
+            parse_number(row.input.record.get(i).unwrap_or(b""))
+        } else {
+            // A number given on the command line: parsed once, where it was given.
+            match row.input.numbers.get(i) {
+                Some(v) if v.is_finite() => Ok(*v),
+                _ => Err(CellError::NotFinite),
+            }
+        };
+        match parsed {
             Ok(v) => {
                 row.values[k] = if plan.inputs[k].1 && !plan.units.radians {
                     v.to_radians()

@@ -3,25 +3,20 @@
 //!
 //! - a *tool-centre program* (`verne ik PROGRAM.ngc`, `verne verify --path PROGRAM.ngc`): X Y Z
 //!   the tool tip in the workpiece frame, the orientation as two angle words (phi1, phi2) or as
-//!   I J K ([`TcpRows`]);
+//!   I J K (read as a toolpath: [`crate::toolpath::gcode`]);
 //! - a *joint program* (`verne verify --joints POST.ngc`): one letter per joint
 //!   ([`JointProgram`]).
 //!
 //! A word the program's kind does not use is an error at its line, never ignored.
 
 use std::io::{BufRead, Write};
-use std::sync::{Arc, Mutex};
 
-use nalgebra::Vector3;
-use verne::machine::orientation::{tool_axis, unit_axis};
 use verne::parallel_module::equations::Sliders;
 use verne::spec::gcode::{GcodeOrientation, GcodeWords, JOINT_KEYS};
-use verne::verify::{Item, JointSource, Joints, PathPoint, RowSource};
-use verne_gcode::{AXES, Axis, GcodeError, Motion, Options, Reader, Row, Summary};
+use verne::verify::{Item, JointSource, Joints, RowSource};
+use verne_gcode::{AXES, Axis, GcodeError, Motion, Options, Reader, Summary};
 
 use crate::error::VerneError;
-use crate::input::resample::{PathPose, PoseStream};
-use crate::input::rows::{FieldRow, FieldRows, invalid_data};
 
 /// A G-code reader over a boxed input, as the CLI reads files and stdin alike.
 pub type GcodeReader = Reader<Box<dyn BufRead + Send>>;
@@ -34,7 +29,7 @@ pub fn gcode_error(file: &str, e: &GcodeError) -> VerneError {
 }
 
 /// The letters of a mask, e.g. `U V`.
-fn letters(mask: u16) -> String {
+pub(crate) fn letters(mask: u16) -> String {
     let v: Vec<String> = AXES
         .iter()
         .filter(|a| mask & a.bit() != 0)
@@ -44,7 +39,7 @@ fn letters(mask: u16) -> String {
 }
 
 /// `is not a word of` or `are not words of`, for the letters of a mask.
-fn not_words(mask: u16) -> &'static str {
+pub(crate) fn not_words(mask: u16) -> &'static str {
     if mask.count_ones() == 1 {
         "is not a word of"
     } else {
@@ -52,7 +47,7 @@ fn not_words(mask: u16) -> &'static str {
     }
 }
 
-fn axis_of(letter: char) -> Axis {
+pub(crate) fn axis_of(letter: char) -> Axis {
     // The machine file's letters are validated (X Y Z A B C U V W).
     Axis::from_letter(letter as u8).unwrap_or(Axis::X)
 }
@@ -83,264 +78,6 @@ pub fn report_summary(cmd: &str, name: &str, s: &Summary) {
             s.lines_after_end,
             s.end_line.unwrap_or(0)
         );
-    }
-}
-
-/// A tool pose of a tool-centre program.
-pub struct TcpPose {
-    pub row: Row,
-    pub tip: [f64; 3],
-    pub axis: [f64; 3],
-    /// The angle words (phi1, phi2) in rad, for a program that gives the orientation by them.
-    pub angles: Option<(f64, f64)>,
-}
-
-/// The poses of a tool-centre program.
-pub struct TcpRows {
-    reader: GcodeReader,
-    name: String,
-    orientation: GcodeOrientation,
-    allowed: u16,
-    summary: Arc<Mutex<Summary>>,
-}
-
-impl TcpRows {
-    /// The tool-centre program read by `reader`, with the machine's words.
-    pub fn new(reader: GcodeReader, name: &str, words: &GcodeWords) -> TcpRows {
-        let xyz = Axis::X.bit() | Axis::Y.bit() | Axis::Z.bit();
-        let allowed = match words.orientation {
-            GcodeOrientation::Angles { phi1, phi2 } => {
-                xyz | axis_of(phi1).bit() | axis_of(phi2).bit()
-            }
-            GcodeOrientation::Vector => xyz,
-        };
-        let summary = Arc::new(Mutex::new(reader.summary().clone()));
-        TcpRows {
-            reader,
-            name: name.to_string(),
-            orientation: words.orientation,
-            allowed,
-            summary,
-        }
-    }
-
-    /// The reader's summary, shared (complete once the rows are read to their end).
-    pub fn summary(&self) -> Arc<Mutex<Summary>> {
-        self.summary.clone()
-    }
-
-    /// The words of a tool-centre program, for messages.
-    fn words(&self) -> String {
-        match self.orientation {
-            GcodeOrientation::Angles { phi1, phi2 } => {
-                format!("X Y Z the tool tip, {phi1} = phi1 and {phi2} = phi2")
-            }
-            GcodeOrientation::Vector => "X Y Z the tool tip and I J K the tool axis".into(),
-        }
-    }
-
-    /// The next pose; errors carry the file's name, line and what was expected.
-    pub fn next_pose(&mut self) -> Option<Result<TcpPose, VerneError>> {
-        let row = match self.reader.next() {
-            None => {
-                if let Ok(mut s) = self.summary.lock() {
-                    *s = self.reader.summary().clone();
-                }
-                return None;
-            }
-            Some(Err(e)) => return Some(Err(gcode_error(&self.name, &e))),
-            Some(Ok(r)) => r,
-        };
-        let fail = |m: String| Some(Err(VerneError::input(&self.name, Some(row.line), None, m)));
-        let stray = row.written & !self.allowed;
-        if stray != 0 {
-            return fail(format!(
-                "{} {} a tool-centre program ({}; the machine file's [gcode] table): is this a joint program? check it with verne verify --joints",
-                letters(stray),
-                not_words(stray),
-                self.words()
-            ));
-        }
-        let tip = [row.get(Axis::X), row.get(Axis::Y), row.get(Axis::Z)];
-        let mut angles = None;
-        let axis = match self.orientation {
-            GcodeOrientation::Angles { phi1, phi2 } => {
-                let (p1, p2) = (row.get(axis_of(phi1)), row.get(axis_of(phi2)));
-                angles = Some((p1.to_radians(), p2.to_radians()));
-                let v = tool_axis(p1.to_radians(), p2.to_radians());
-                [v.x, v.y, v.z]
-            }
-            GcodeOrientation::Vector => row.tool_vector.unwrap_or([f64::NAN; 3]),
-        };
-        let missing = self.allowed & !row.known;
-        if missing != 0 || axis.iter().any(|v| v.is_nan()) {
-            let what = if missing != 0 {
-                letters(missing)
-            } else {
-                "I J K".to_string()
-            };
-            return fail(format!(
-                "the tool pose is not known yet ({what} not given): a tool-centre program gives {} by its first move",
-                self.words()
-            ));
-        }
-        Some(Ok(TcpPose {
-            row,
-            tip,
-            axis,
-            angles,
-        }))
-    }
-}
-
-impl FieldRows for TcpRows {
-    fn header(&self) -> &'static [&'static str] {
-        &[
-            "line", "n", "kind", "motion", "feed", "dt", "tool", "x", "y", "z", "i", "j", "k",
-        ]
-    }
-
-    fn next_row(&mut self, row: &mut FieldRow<'_>) -> std::io::Result<bool> {
-        let Some(p) = self.next_pose_or_end()? else {
-            return Ok(false);
-        };
-        let r = &p.row;
-        row.field(r.line);
-        match r.n {
-            Some(n) => row.field(format_args!("N{n}")),
-            None => row.optional(None::<u64>),
-        }
-        row.field(r.kind.as_str());
-        row.field(r.motion.as_str());
-        row.optional(r.feed_per_min.filter(|_| r.motion == Motion::Feed));
-        // The time of the move as the program states it (its feed, G93), s.
-        row.optional(r.duration_s);
-        row.optional(r.tool);
-        for v in p.tip.iter().chain(&p.axis) {
-            row.field(v);
-        }
-        Ok(true)
-    }
-}
-
-impl TcpRows {
-    /// The next pose, `None` at the end; an error as the row engine reports it (it names
-    /// the file itself), and a program without a move is an error.
-    fn next_pose_or_end(&mut self) -> std::io::Result<Option<TcpPose>> {
-        match self.next_pose() {
-            None => {
-                if self.reader.summary().rows == 0 {
-                    return Err(invalid_data(
-                        "no move (G0, G1, G2, G3 or a cycle): no tool pose to convert".into(),
-                    ));
-                }
-                Ok(None)
-            }
-            Some(Err(e)) => Err(invalid_data(match e {
-                VerneError::Input {
-                    line: Some(line),
-                    column,
-                    message,
-                    ..
-                } => match column {
-                    Some(c) => format!("line {line}, column {c}: {message}"),
-                    None => format!("line {line}: {message}"),
-                },
-                other => other.to_string(),
-            })),
-            Some(Ok(p)) => Ok(Some(p)),
-        }
-    }
-}
-
-/// A tool-centre program read by the `--period` resampler directly: the program's angle
-/// words go with each pose, so the stream turns the rotary axes as the controller does.
-impl PoseStream for TcpRows {
-    fn states_angles(&self) -> bool {
-        matches!(self.orientation, GcodeOrientation::Angles { .. })
-    }
-
-    fn next_pose(&mut self) -> std::io::Result<Option<PathPose>> {
-        let Some(p) = self.next_pose_or_end()? else {
-            return Ok(None);
-        };
-        let r = &p.row;
-        let axis = Vector3::from(p.axis);
-        let n = axis.norm();
-        if n.is_nan() || n <= 1e-12 {
-            return Err(invalid_data(format!(
-                "line {}: the tool axis is zero",
-                r.line
-            )));
-        }
-        Ok(Some(PathPose {
-            tip: Vector3::from(p.tip),
-            axis: axis / n,
-            angles: p.angles,
-            line: r.line.to_string(),
-            rapid: r.motion == Motion::Rapid,
-            feed_mm_min: r.feed_per_min.filter(|_| r.motion == Motion::Feed),
-            dt: r.duration_s,
-        }))
-    }
-}
-
-/// A tool-centre program as the intended path of `verne verify`.
-pub struct TcpPath {
-    rows: TcpRows,
-    index: u64,
-    offset: Vector3<f64>,
-}
-
-impl TcpPath {
-    pub fn new(rows: TcpRows, offset: Vector3<f64>) -> TcpPath {
-        TcpPath {
-            rows,
-            index: 0,
-            offset,
-        }
-    }
-
-    /// What the reader saw besides the rows.
-    pub fn summary(&self) -> Summary {
-        self.rows.reader.summary().clone()
-    }
-}
-
-impl RowSource for TcpPath {
-    type Row = PathPoint;
-    type Error = VerneError;
-
-    fn name(&self) -> &str {
-        &self.rows.name
-    }
-
-    fn has_id(&self) -> bool {
-        false
-    }
-
-    fn next_item(&mut self) -> Result<Option<Item<PathPoint>>, VerneError> {
-        let Some(pose) = self.rows.next_pose() else {
-            return Ok(None);
-        };
-        let p = pose?;
-        self.index += 1;
-        let value = unit_axis(&Vector3::from(p.axis))
-            .map(|axis| PathPoint {
-                tip: Vector3::from(p.tip) + self.offset,
-                axis,
-                rapid: p.row.motion == Motion::Rapid,
-                feed: p.row.feed_per_min.map(|f| f / 60.0),
-                duration: p.row.duration_s,
-                angles: p.angles,
-            })
-            .map_err(|e| e.to_string());
-        Ok(Some(Item {
-            index: self.index,
-            line: p.row.line,
-            id: p.row.n.map(|n| format!("N{n}")),
-            value,
-        }))
     }
 }
 

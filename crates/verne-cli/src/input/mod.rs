@@ -1,13 +1,9 @@
-//! Readers of the inputs that are not plain row tables: CL files ([`cl`], over the `verne-cl`
-//! crate), the two inputs of `verne verify` ([`verify_files`]) and a controller's recorded joints
-//! ([`recording`]). CSV reading itself is in
-//! [`crate::table`].
+//! Readers of the joint inputs of `verne verify`: a joint table or a G-code joint program
+//! ([`verify_files`], [`gcode`]) and a controller's recorded joints ([`recording`]). Toolpaths
+//! are read by [`crate::toolpath`]; CSV reading itself is in [`crate::table`].
 
-pub mod cl;
 pub mod gcode;
 pub mod recording;
-pub mod resample;
-pub mod rows;
 pub mod verify_files;
 
 /// A reader's warnings on stderr, `verne CMD: NAME: warning: ...`, and how many it stopped

@@ -1,20 +1,24 @@
-//! The inputs of `verne verify`: the postprocessor's joint table (CSV) and the intended path (CSV
-//! or APT CL), read row by row for the core's checks ([`verne::verify::RowSource`]), with
-//! file/line/column errors for malformed cells.
+//! The inputs of `verne verify`: the postprocessor's joint table (a CSV or a G-code joint
+//! program) and the intended path (a toolpath: CSV, CL file or tool-centre program), read row by
+//! row for the core's checks ([`verne::verify::RowSource`]), with file/line/column errors for
+//! malformed cells.
 
 use std::path::Path;
 
 use csv::ByteRecord;
 use nalgebra::Vector3;
 use verne::error::shown;
-use verne::machine::orientation::{tool_axis, unit_axis};
 use verne::parallel_module::equations::Sliders;
 use verne::verify::{Item, JOINT_NAMES, JointSource, Joints, PathPoint, RowSource};
 
 use crate::error::VerneError;
-use crate::input::cl::{ClReader, PathInput, ReadOptions, cl_error, open_path_input};
-use crate::input::gcode::{JointProgram, TcpPath, TcpRows};
+use crate::input::gcode::JointProgram;
 use crate::table::{CellError, CsvSource, parse_number};
+use crate::toolpath::columns::{parse_motion, parse_positive_cell};
+use crate::toolpath::csv::CsvToolpath;
+use crate::toolpath::gcode::TcpToolpath;
+use crate::toolpath::open::{Format, Input, ReadOptions};
+use crate::toolpath::{PoseRow, ReaderReport, ToolpathSource};
 
 /// Reads a cell as a number; a non-number is fatal (file, line, column), an empty or non-finite
 /// cell makes the row invalid.
@@ -49,6 +53,8 @@ pub struct JointReader {
     id: Option<usize>,
     t: Option<usize>,
     feed: Option<usize>,
+    /// `dt`: the time of the move to the row (s).
+    dt: Option<usize>,
     /// `motion` (`rapid` or `feed`, as `verne ik` writes it from a CL file or a program).
     motion: Option<usize>,
     rec: ByteRecord,
@@ -63,6 +69,7 @@ impl JointReader {
             id: src.column("id"),
             t: src.column("t"),
             feed: src.column("feed"),
+            dt: src.column("dt"),
             motion: src.column("motion"),
             src,
             rec: ByteRecord::new(),
@@ -71,104 +78,61 @@ impl JointReader {
     }
 }
 
-#[allow(clippy::large_enum_variant)] // one per run
-enum PathKind {
-    Csv {
-        src: CsvSource,
-        xyz: [usize; 3],
-        /// i,j,k or phi1,phi2 (then the third is unused).
-        orient: [usize; 3],
-        angles: bool,
-        id: Option<usize>,
-        rec: ByteRecord,
-    },
-    Cl {
-        reader: Box<ClReader>,
-    },
-    Gcode(TcpPath),
-}
-
-/// The intended path: a CSV (`x,y,z` and `i,j,k` or `phi1,phi2` in degrees, optional `id`) or a
-/// CL file (its rows in file order, with rapid/feed and the feed of each move).
+/// The intended path: a CSV of tool poses, a CL file or a tool-centre program, read as a
+/// toolpath ([`crate::toolpath`]: the same readers and the same column detector as `verne ik`).
 pub struct PathReader {
-    kind: PathKind,
-    name: String,
+    source: Box<dyn ToolpathSource>,
     index: u64,
     /// Where the part sits on the table (mm): added to every tip.
     offset: Vector3<f64>,
+    has_id: bool,
+    row: PoseRow,
 }
 
 impl PathReader {
-    /// Opens a path file: a CL file (by its extension or its first record, any dialect of
-    /// `docs/cl-dialects.md`) or CSV. `offset` (mm) is added to every tip.
+    /// Opens a path file: a CL file or a G-code program (by its extension or its first record
+    /// or block) or a CSV of tool poses (angles in degrees). `offset` (mm) is added to every
+    /// tip.
     pub fn open(
         path: &Path,
         options: &ReadOptions,
         offset: Vector3<f64>,
     ) -> Result<PathReader, VerneError> {
-        let mut reader = match open_path_input(Some(path), None, options)? {
-            PathInput::Cl(reader, name) => PathReader {
-                kind: PathKind::Cl { reader },
-                name,
-                index: 0,
-                offset,
-            },
-            PathInput::Gcode(reader, name) => PathReader {
-                kind: PathKind::Gcode(TcpPath::new(
-                    TcpRows::new(*reader, &name, &options.words),
-                    offset,
-                )),
-                name,
-                index: 0,
-                offset,
-            },
-            PathInput::Csv(src) => Self::from_csv(src)?,
+        let input = Input::open(Some(path), None, &[Format::Csv, Format::Cl, Format::Gcode])?;
+        let source: Box<dyn ToolpathSource> = match input.format {
+            Format::Cl => Box::new(input.into_cl(options.cl)?),
+            Format::Gcode => {
+                let name = input.name.clone();
+                let reader = input.into_gcode(options.gcode)?;
+                Box::new(TcpToolpath::new(reader, &name, &options.words))
+            }
+            Format::Csv => {
+                let csv = input.into_csv()?;
+                csv.require(&["x", "y", "z"])?;
+                Box::new(CsvToolpath::new(csv, false)?)
+            }
         };
-        reader.offset = offset;
-        Ok(reader)
+        Ok(Self::new(source, offset))
     }
 
-    /// What the CL reader saw besides the rows (complete once the rows are read), and the
-    /// file's name; `None` for a CSV path.
-    pub fn cl_summary(&self) -> Option<(&str, &verne_cl::Summary)> {
-        match &self.kind {
-            PathKind::Cl { reader } => Some((&self.name, reader.summary())),
-            _ => None,
-        }
-    }
-
-    /// What the G-code reader saw besides the rows, and the file's name; `None` for other
-    /// paths.
-    pub fn gcode_summary(&self) -> Option<(&str, verne_gcode::Summary)> {
-        match &self.kind {
-            PathKind::Gcode(p) => Some((&self.name, p.summary())),
-            _ => None,
-        }
-    }
-
-    /// A CSV path from an opened source.
-    pub fn from_csv(src: CsvSource) -> Result<PathReader, VerneError> {
-        let xyz = src.require(&["x", "y", "z"])?;
-        let (orient, angles) = if src.column("i").is_some() || src.column("phi1").is_none() {
-            let c = src.require(&["x", "y", "z", "i", "j", "k"])?;
-            ([c[3], c[4], c[5]], false)
-        } else {
-            let c = src.require(&["x", "y", "z", "phi1", "phi2"])?;
-            ([c[3], c[4], c[4]], true)
-        };
-        Ok(PathReader {
-            name: src.name().to_string(),
-            kind: PathKind::Csv {
-                xyz: [xyz[0], xyz[1], xyz[2]],
-                orient,
-                angles,
-                id: src.column("id"),
-                src,
-                rec: ByteRecord::new(),
-            },
+    /// The intended path read from `source`.
+    pub fn new(source: Box<dyn ToolpathSource>, offset: Vector3<f64>) -> PathReader {
+        let has_id = source
+            .columns()
+            .iter()
+            .any(|c| c.name.eq_ignore_ascii_case("id"));
+        PathReader {
+            source,
             index: 0,
-            offset: Vector3::zeros(),
-        })
+            offset,
+            has_id,
+            row: PoseRow::default(),
+        }
+    }
+
+    /// What the reader saw besides the rows (complete once the rows are read).
+    pub fn report(&self) -> ReaderReport {
+        self.source.report()
     }
 }
 
@@ -218,14 +182,29 @@ impl RowSource for JointReader {
                 }
             };
         let t = optional(self.t, "t", "s")?;
-        // A rapid row has no feed (the machine's rapid rate): its empty feed cell is no gap.
-        let rapid = self.motion.is_some_and(|i| {
-            self.rec
-                .get(i)
-                .is_some_and(|m| m.eq_ignore_ascii_case(b"rapid"))
-        });
-        let feed_column = if rapid { None } else { self.feed };
-        let feed = optional(feed_column, "feed", "mm/min")?.map(|f| f / 60.0);
+        // `motion`, `feed` and `dt` are read as `verne ik` reads them (one reader of each).
+        let column_error = |i: usize, m: String| {
+            VerneError::input(&name, Some(line), Some(&self.src.header_name(i)), m)
+        };
+        let rec = &self.rec;
+        let motion = match self.motion {
+            Some(i) => parse_motion(rec.get(i).unwrap_or(b"")).map_err(|m| column_error(i, m))?,
+            None => None,
+        };
+        let rapid = motion == Some(crate::toolpath::Motion::Rapid);
+        // A rapid row has no feed (the machine's rapid rate); a feed row before the path's
+        // first feed (as NX writes) has none either: the segment is then untimed.
+        let feed = match self.feed {
+            Some(i) if !rapid => parse_positive_cell(rec.get(i).unwrap_or(b""), "a feed in mm/min")
+                .map_err(|m| column_error(i, m))?
+                .map(|f| f / 60.0),
+            _ => None,
+        };
+        let duration = match self.dt {
+            Some(i) => parse_positive_cell(rec.get(i).unwrap_or(b""), "a time in s")
+                .map_err(|m| column_error(i, m))?,
+            None => None,
+        };
         let id = self
             .id
             .map(|i| String::from_utf8_lossy(self.rec.get(i).unwrap_or(b"")).into_owned());
@@ -237,7 +216,7 @@ impl RowSource for JointReader {
                 theta2: v[4],
                 t,
                 feed,
-                duration: None,
+                duration,
                 rapid,
             }),
         };
@@ -253,7 +232,7 @@ impl RowSource for JointReader {
 impl JointSource for JointReader {
     /// True when velocities can be checked.
     fn timed(&self) -> bool {
-        self.t.is_some() || self.feed.is_some()
+        self.t.is_some() || self.feed.is_some() || self.dt.is_some()
     }
 }
 
@@ -262,101 +241,25 @@ impl RowSource for PathReader {
     type Error = VerneError;
 
     fn name(&self) -> &str {
-        &self.name
+        self.source.name()
     }
 
     fn has_id(&self) -> bool {
-        matches!(&self.kind, PathKind::Csv { id: Some(_), .. })
+        self.has_id
     }
 
     fn next_item(&mut self) -> Result<Option<Item<PathPoint>>, VerneError> {
-        match &mut self.kind {
-            PathKind::Gcode(p) => p.next_item(),
-            PathKind::Cl { reader } => {
-                let row = match reader.next() {
-                    None => return Ok(None),
-                    Some(r) => r.map_err(|e| cl_error(&self.name, &e))?,
-                };
-                self.index += 1;
-                let axis = Vector3::from(row.axis);
-                let value = unit_axis(&axis)
-                    .map(|axis| PathPoint {
-                        tip: Vector3::from(row.tip) + self.offset,
-                        axis,
-                        rapid: row.motion == verne_cl::Motion::Rapid,
-                        feed: row.feed_mm_min.map(|f| f / 60.0),
-                        duration: None,
-                        angles: None,
-                    })
-                    .map_err(|e| format!("{} at line {}: {e}", row.kind, row.line));
-                Ok(Some(Item {
-                    index: self.index,
-                    line: row.line,
-                    id: None,
-                    value,
-                }))
-            }
-            PathKind::Csv {
-                src,
-                xyz,
-                orient,
-                angles,
-                id,
-                rec,
-            } => {
-                if !src.read(rec)? {
-                    return Ok(None);
-                }
-                self.index += 1;
-                let name = src.name().to_string();
-                let line = rec.position().map(|p| p.line()).unwrap_or(0);
-                let names: [&str; 6] = if *angles {
-                    ["x", "y", "z", "phi1", "phi2", "phi2"]
-                } else {
-                    ["x", "y", "z", "i", "j", "k"]
-                };
-                let cols = [xyz[0], xyz[1], xyz[2], orient[0], orient[1], orient[2]];
-                let mut v = [0.0; 6];
-                let mut bad = None;
-                for k in 0..6 {
-                    let unit = if k < 3 {
-                        "mm"
-                    } else if *angles {
-                        "degrees"
-                    } else {
-                        "unit vector component"
-                    };
-                    match cell(&name, rec, cols[k], names[k], unit)? {
-                        Ok(x) => v[k] = x,
-                        Err(e) => {
-                            bad.get_or_insert(e);
-                        }
-                    }
-                }
-                let id =
-                    id.map(|i| String::from_utf8_lossy(rec.get(i).unwrap_or(b"")).into_owned());
-                let tip = Vector3::new(v[0], v[1], v[2]) + self.offset;
-                let value = match bad {
-                    Some(e) => Err(e),
-                    None if *angles => {
-                        let (p1, p2) = (v[3].to_radians(), v[4].to_radians());
-                        Ok(PathPoint {
-                            angles: Some((p1, p2)),
-                            ..PathPoint::new(tip, tool_axis(p1, p2))
-                        })
-                    }
-                    None => unit_axis(&Vector3::new(v[3], v[4], v[5]))
-                        .map(|axis| PathPoint::new(tip, axis))
-                        .map_err(|e| e.to_string()),
-                };
-                Ok(Some(Item {
-                    index: self.index,
-                    line,
-                    id,
-                    value,
-                }))
-            }
+        if !self.source.next_row(&mut self.row)? {
+            return Ok(None);
         }
+        self.index += 1;
+        let r = &self.row;
+        Ok(Some(Item {
+            index: self.index,
+            line: r.line,
+            id: r.id.clone(),
+            value: r.path_point(&self.offset),
+        }))
     }
 }
 
@@ -371,31 +274,19 @@ pub enum JointInput {
 impl JointInput {
     /// Opens `path` as a G-code joint program or a CSV joint table.
     pub fn open(path: &Path, options: &ReadOptions) -> Result<JointInput, VerneError> {
-        let name = path.display().to_string();
-        let gcode = verne_gcode::has_gcode_extension(&name) || {
-            use std::io::Read;
-            let mut head = Vec::with_capacity(verne_cl::SNIFF_BYTES);
-            if path.as_os_str() != "-" {
-                let f =
-                    crate::table::open_input_file(path).map_err(|e| VerneError::io(&name, e))?;
-                f.take(verne_cl::SNIFF_BYTES as u64)
-                    .read_to_end(&mut head)
-                    .map_err(|e| VerneError::io(&name, e))?;
+        let input = Input::open(Some(path), None, &[Format::Csv, Format::Gcode])?;
+        match input.format {
+            Format::Gcode => {
+                let name = input.name.clone();
+                let reader = input.into_gcode(options.gcode)?;
+                Ok(JointInput::Gcode(JointProgram::new(
+                    reader,
+                    &name,
+                    &options.words,
+                )))
             }
-            verne_gcode::sniff_content(&head)
-        };
-        if !gcode {
-            return Ok(JointInput::Csv(JointReader::new(CsvSource::open(Some(
-                path,
-            ))?)?));
+            _ => Ok(JointInput::Csv(JointReader::new(input.into_csv()?)?)),
         }
-        let f = crate::table::open_input_file(path).map_err(|e| VerneError::io(&name, e))?;
-        let input: Box<dyn std::io::BufRead + Send> =
-            Box::new(std::io::BufReader::with_capacity(64 * 1024, f));
-        let reader = verne_gcode::Reader::new(input, options.gcode)
-            .map_err(|e| crate::input::gcode::gcode_error(&name, &e))?;
-        let program = JointProgram::new(reader, &name, &options.words);
-        Ok(JointInput::Gcode(program))
     }
 
     /// What the G-code reader saw besides the rows, for a G-code joint program.

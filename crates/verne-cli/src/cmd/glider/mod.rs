@@ -33,18 +33,16 @@ use crate::table::CsvSource;
 /// Decimals of the aligned tables of `verne modes` (unless `--precision`).
 const TABLE_DECIMALS: usize = 6;
 
-/// The rows of `--pose X,Y,0` / `--joints R1,R2,0` as an in-memory CSV with `header`; the third
-/// value of a planar mechanism must be 0.
-fn inline_planar(header: &str, flag: &str, rows: &[[f64; 3]]) -> Result<CsvSource, VerneError> {
-    let mut text = format!("{header}\n");
+/// The rows of `--pose X,Y,0` / `--joints R1,R2,0` as numbers in the columns `header`; the
+/// third value of a planar mechanism must be 0.
+fn inline_planar(header: &[&str], flag: &str, rows: &[[f64; 3]]) -> Result<CsvSource, VerneError> {
     for r in rows {
         planar(*r, flag)?;
-        text.push_str(&format!("{},{}\n", r[0], r[1]));
     }
-    CsvSource::from_reader(
-        Box::new(std::io::Cursor::new(text.into_bytes())),
-        "<command line>",
-    )
+    Ok(crate::cmd::inline_source(
+        header,
+        rows.iter().map(|r| vec![r[0], r[1]]).collect(),
+    ))
 }
 
 /// A point given to a glider: `A,B` (or `A,B,0`).
@@ -96,7 +94,7 @@ pub fn ik(args: &IkArgs, spec: GliderSpec) -> Result<u8, VerneError> {
     let source = if args.pose.is_empty() {
         CsvSource::open(args.input.as_deref())?
     } else {
-        inline_planar("x,y", "--pose", &args.pose)?
+        inline_planar(&["x", "y"], "--pose", &args.pose)?
     };
     let mut job = GliderIk {
         spec,
@@ -119,7 +117,7 @@ pub fn fk(args: &FkArgs, spec: GliderSpec) -> Result<u8, VerneError> {
     let source = if args.joints.is_empty() {
         CsvSource::open(args.input.as_deref())?
     } else {
-        inline_planar("rho1,rho2", "--joints", &args.joints)?
+        inline_planar(&["rho1", "rho2"], "--joints", &args.joints)?
     };
     let mut job = GliderFk {
         spec,
