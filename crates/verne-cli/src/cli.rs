@@ -140,6 +140,22 @@ pub struct IkArgs {
     /// Every real branch, one row each, instead of the machine's working branch.
     #[arg(long)]
     pub all: bool,
+    /// CSV output: insert the poses that keep the tool within --chord-tol and --axis-tol of the
+    /// intended move between rows, as the joint program does (rows flagged `inserted`).
+    #[arg(long, conflicts_with = "no_linearize")]
+    pub linearize: bool,
+    /// A joint program or list: one block per path row, without the poses that keep the tool
+    /// on the intended move between them.
+    #[arg(long)]
+    pub no_linearize: bool,
+    /// Angular tolerance (degrees) of the joint program's blocks: the tool axis of the
+    /// interpolated joints from the intended move's. Default: the machine's chord_axis_error_deg.
+    #[arg(long, value_name = "DEG", value_parser = parse_positive)]
+    pub axis_tol: Option<f64>,
+    /// Write the blocks the drives slow below their programmed feed, as CSV: block, line,
+    /// limit, share of it, the time at the feed and the time scheduled (s), the feeds.
+    #[arg(long, value_name = "FILE.csv")]
+    pub schedule_report: Option<PathBuf>,
     #[command(flatten)]
     pub part: PartArgs,
     #[command(flatten)]
@@ -233,10 +249,11 @@ pub struct PartArgs {
     /// error.
     #[arg(long, value_enum, value_name = "UNITS")]
     pub units: Option<ClUnits>,
-    /// Chordal tolerance (mm) of the points interpolated on arcs (a CL file's CIRCLE, G-code's
-    /// G2/G3).
-    #[arg(long = "chord-tol", value_name = "MM", value_parser = crate::arg_values::parse_positive, default_value_t = verne_cl::DEFAULT_CHORD_TOL_MM)]
-    pub chord_tol: f64,
+    /// Chordal tolerance (mm): of the points interpolated on arcs (a CL file's CIRCLE, G-code's
+    /// G2/G3; default 0.005), and of the joint program's blocks (`verne ik`: the tip of the
+    /// interpolated joints from the intended move; default the machine's chord_error_mm).
+    #[arg(long = "chord-tol", value_name = "MM", value_parser = crate::arg_values::parse_positive)]
+    pub chord_tol: Option<f64>,
     /// Where the part sits on the table: X,Y,Z (mm) added to every tool tip read (CAM's part
     /// frame -> the machine's workpiece frame); `verne fk --offset` takes it off again.
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_triple, allow_hyphen_values = true)]
@@ -247,7 +264,7 @@ impl PartArgs {
     /// The CL reader's options.
     pub fn cl_options(&self) -> verne_cl::Options {
         verne_cl::Options {
-            chord_tol_mm: self.chord_tol,
+            chord_tol_mm: self.arc_tol(),
             units: self.units.map(|u| match u {
                 ClUnits::Mm => verne_cl::Units::Mm,
                 ClUnits::In => verne_cl::Units::Inch,
@@ -264,9 +281,14 @@ impl PartArgs {
         });
         ReadOptions {
             cl: self.cl_options(),
-            gcode: crate::input::gcode::options(self.chord_tol, units, words),
+            gcode: crate::input::gcode::options(self.arc_tol(), units, words),
             words: *words,
         }
+    }
+
+    /// The chordal tolerance of arcs (mm).
+    pub fn arc_tol(&self) -> f64 {
+        self.chord_tol.unwrap_or(verne_cl::DEFAULT_CHORD_TOL_MM)
     }
 
     /// The part's offset (zero when not given).

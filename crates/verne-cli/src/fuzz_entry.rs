@@ -59,7 +59,7 @@ pub fn csv_tool_rows(data: &[u8]) {
             period: None,
         });
         let mut sink = crate::follow::write::CsvRows::to_writer(Box::new(std::io::sink()), all);
-        let _ = crate::follow::run(&mut path, &mut follower, &mut sink, &|_| {});
+        let _ = crate::follow::run(&mut path, &mut follower, None, &mut sink, &|_| {});
     }
 }
 

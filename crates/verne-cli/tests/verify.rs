@@ -266,9 +266,35 @@ fn theta2_off_by_a_full_turn_is_a_joint_jump_on_both_segments() {
     let k = 250;
     joints[k - 1].theta2 += 2.0 * PI;
     let run = verify("turn", &joints_csv(&joints, true), &path_csv(&poses), &[]);
-    only(&run, "joint_jump", &[k, k + 1]);
-    assert!(run.findings.iter().all(|f| f.detail.contains("theta2")));
-    assert!(run.findings.iter().all(|f| (f.value - 360.0).abs() < 5.0));
+    let jumps: Vec<&Finding> = run
+        .findings
+        .iter()
+        .filter(|f| f.check == "joint_jump")
+        .collect();
+    let rows: Vec<&str> = jumps.iter().map(|f| f.row.as_str()).collect();
+    assert_eq!(
+        rows,
+        [k.to_string(), (k + 1).to_string()],
+        "{:#?}",
+        run.findings
+    );
+    assert!(jumps.iter().all(|f| f.detail.contains("theta2")));
+    assert!(jumps.iter().all(|f| (f.value - 360.0).abs() < 5.0));
+    // The table really turns: its chord and axis along the jumps are findings of their own,
+    // on the same rows, and nothing else is.
+    for f in &run.findings {
+        assert!(
+            ["joint_jump", "chord_error", "chord_axis"].contains(&f.check.as_str())
+                && (f.row == k.to_string() || f.row == (k + 1).to_string()),
+            "{f:?}"
+        );
+    }
+    assert!(
+        run.findings
+            .iter()
+            .any(|f| f.check == "chord_error" && f.value > 1.0)
+    );
+    assert_eq!(run.code, 1);
 }
 
 /// Another working branch of the same tool pose, with theta2 taken near the path's.
@@ -451,8 +477,14 @@ fn rows_dropped_from_both_files_are_a_joint_jump() {
     let j: Vec<Joints> = (1..=400).filter(keep).map(|k| joints[k - 1]).collect();
     let run = verify("drop", &joints_csv(&j, false), &path_csv(&p), &[]);
     let checks: Vec<&str> = run.findings.iter().map(|f| f.check.as_str()).collect();
+    // The jump, and the gouge it makes: the tool's distance from the straight move between the
+    // two rows, measured along the interpolated joints.
     assert!(
-        !checks.is_empty() && checks.iter().all(|c| *c == "joint_jump"),
+        checks.contains(&"joint_jump")
+            && checks.contains(&"chord_error")
+            && checks
+                .iter()
+                .all(|c| ["joint_jump", "chord_error", "chord_axis"].contains(c)),
         "{:#?}",
         run.findings
     );
@@ -497,12 +529,22 @@ fn ids_pair_rows_and_a_missing_id_is_reported() {
 #[test]
 fn fatal_inputs_exit_2_with_file_line_and_column() {
     let (poses, joints) = library_path(20);
-    // Row counts differ without ids: fatal.
+    // Row counts differ without ids: the rows the joint table lacks are pairing findings (the
+    // rest is checked, and the report is written).
     let j = joints_csv(&joints[..19], false).replace("id,", "n,");
     let p = path_csv(&poses).replace("id,", "n,");
     let run = verify("count", &j, &p, &[]);
-    assert_eq!(run.code, 2);
-    assert!(run.stderr.contains("more rows"), "{}", run.stderr);
+    assert_eq!(run.code, 1, "{}", run.stderr);
+    assert_eq!(run.findings.len(), 1, "{:#?}", run.findings);
+    assert_eq!(run.findings[0].check, "pairing");
+    assert!(
+        run.findings[0]
+            .detail
+            .contains("row 20 (line 21) has no joint row"),
+        "{:#?}",
+        run.findings
+    );
+
     // A cell that is not a number.
     let j = joints_csv(&joints, false).replacen("\n3,", "\n3,abc", 1);
     let run = verify("cell", &j, &path_csv(&poses), &[]);
@@ -571,7 +613,8 @@ fn json_summary_and_deterministic_report() {
     );
     assert!(a.stdout.contains("\"clean\":false"));
     assert_eq!(a.code, 1);
-    let rows: Vec<&str> = a.findings.iter().map(|f| f.row.as_str()).collect();
+    let mut rows: Vec<&str> = a.findings.iter().map(|f| f.row.as_str()).collect();
+    rows.dedup();
     assert_eq!(rows, ["701", "2101", "2102"], "{:#?}", a.findings);
 }
 

@@ -223,6 +223,7 @@ pub(crate) fn interpolate(
             known: state.known | written,
             written,
             tool_vector: state.tool_vector,
+            comment: None,
         });
     }
     // Durations: each chord at the feed; under G93 the block's time shared by chord length.

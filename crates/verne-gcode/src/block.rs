@@ -28,6 +28,8 @@ pub struct Block {
     pub percent: bool,
     /// The `N` word (the first one; more than one is an error).
     pub n: Option<u64>,
+    /// The block's first comment `( )`, trimmed (a post's note on the block).
+    pub comment: Option<super::types::Note>,
     words: [Word; MAX_WORDS],
     len: usize,
 }
@@ -38,6 +40,7 @@ impl Block {
             deleted: false,
             percent: false,
             n: None,
+            comment: None,
             words: [Word {
                 letter: 0,
                 value: 0.0,
@@ -57,6 +60,7 @@ impl Block {
         self.deleted = false;
         self.percent = false;
         self.n = None;
+        self.comment = None;
         self.len = 0;
         let err = |i: usize, m: String| Err(GcodeError::new(line, Some(i as u64 + 1), m));
         let mut i = skip_blank(text, 0);
@@ -84,8 +88,13 @@ impl Block {
                     let Some(end) = text[i + 1..].iter().position(|&b| b == b')') else {
                         return err(i, "comment `(` not closed on its line".into());
                     };
-                    if text[i + 1..i + 1 + end].contains(&b'(') {
+                    let inside = &text[i + 1..i + 1 + end];
+                    if inside.contains(&b'(') {
                         return err(i, "a comment may not contain `(` (nested comment)".into());
+                    }
+                    if self.comment.is_none() {
+                        let text = String::from_utf8_lossy(inside.trim_ascii());
+                        self.comment = Some(super::types::Note::new(&text));
                     }
                     i += end + 2;
                 }

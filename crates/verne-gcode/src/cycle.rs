@@ -162,6 +162,7 @@ pub(crate) fn expand(
                 known: state.known | Axis::X.bit() | Axis::Y.bit() | Axis::Z.bit(),
                 written: Axis::X.bit() | Axis::Y.bit() | Axis::Z.bit(),
                 tool_vector: state.tool_vector,
+                comment: None,
             });
         };
     if fresh && p[Z] < r {

@@ -40,7 +40,7 @@ pub use error::{GcodeError, Warning};
 pub use reader::Reader;
 pub use types::{
     AXES, Axis, DEFAULT_CHORD_TOL_MM, DEFAULT_MAX_ARC_POINTS, DEFAULT_MAX_LINE_BYTES, Kind,
-    MAX_WARNINGS, MM_PER_INCH, Motion, Options, Row, Summary, Units,
+    MAX_WARNINGS, MM_PER_INCH, Motion, NOTE_BYTES, Note, Options, Row, Summary, Units,
 };
 
 /// File extensions of G-code programs (compared ignoring case).

@@ -737,6 +737,7 @@ impl<R: BufRead> Reader<R> {
             known: self.state.known,
             written,
             tool_vector: vector,
+            comment: b.comment,
         });
         Ok(())
     }

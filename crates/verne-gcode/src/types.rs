@@ -223,6 +223,41 @@ pub struct Row {
     /// The tool-axis vector (`I J K`, normalised), when [`Options::ijk_tool_vector`] is set and
     /// the program has given one.
     pub tool_vector: Option<[f64; 3]>,
+    /// The first comment of a straight move's block, trimmed (a post's note on the block, such
+    /// as the toolpath line a joint program's block leads to); `None` for arcs and cycles.
+    pub comment: Option<Note>,
+}
+
+/// The start of a block's comment: its first [`NOTE_BYTES`] bytes, kept inline so that rows
+/// stay `Copy`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Note {
+    bytes: [u8; NOTE_BYTES],
+    len: u8,
+}
+
+/// Bytes of a comment a [`Note`] keeps.
+pub const NOTE_BYTES: usize = 40;
+
+impl Note {
+    /// The note of a comment's text (its first [`NOTE_BYTES`] bytes, cut at a character).
+    pub fn new(text: &str) -> Note {
+        let mut end = text.len().min(NOTE_BYTES);
+        while !text.is_char_boundary(end) {
+            end -= 1;
+        }
+        let mut bytes = [0u8; NOTE_BYTES];
+        bytes[..end].copy_from_slice(&text.as_bytes()[..end]);
+        Note {
+            bytes,
+            len: end as u8,
+        }
+    }
+
+    /// The note's text.
+    pub fn as_str(&self) -> &str {
+        std::str::from_utf8(&self.bytes[..usize::from(self.len)]).unwrap_or("")
+    }
 }
 
 impl Row {

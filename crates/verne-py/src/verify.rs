@@ -94,6 +94,7 @@ fn next_item<T>(
         line: *next as u64,
         id: None,
         value: usable(row),
+        tag: None,
     })
 }
 

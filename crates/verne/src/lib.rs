@@ -10,6 +10,8 @@
 //! - [`machine`]: the whole machine of AIM 2007 (module plus tilting table, tool orientation,
 //!   a toolpath followed on one branch);
 //! - [`workspace`], [`verify`], [`selftest`]: analyses built on them;
+//! - [`post`]: joint programs a machine can run (linearization within tolerances, block times
+//!   within the drives' limits);
 //! - [`glider`]: the planar glider mechanisms of the comparative study (Wenger 2001);
 //! - [`math`]: root finding, interval and double-double arithmetic, the run-time CPU dispatch;
 //! - [`stream`]: the row engine the streaming commands and [`verify`] run on (three batches
@@ -27,6 +29,7 @@ pub mod machine;
 pub mod math;
 mod par;
 pub mod parallel_module;
+pub mod post;
 pub mod selftest;
 pub mod spec;
 pub mod stream;

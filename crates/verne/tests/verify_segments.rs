@@ -105,7 +105,8 @@ fn the_largest_joint_change_is_a_jump_above_its_limit() {
         let [(k, i, top), (_, _, next)] = two_largest(per_segment, group);
         let limit = 0.5 * (top + next);
         // The slider speeds are limited to nothing too: every segment is a velocity finding
-        // but the one that jumped (a jump ends the segment's checks).
+        // but the one that jumped (its speed is the jump's finding; its chord and limits are
+        // still measured).
         let th = thresholds(&[(name, limit), ("rho_velocity_mm_s", 1e-9)]);
         let (_, found) = run(&m, &th, oks(&joints), path.clone());
         let v = the_one_finding(&found, Check::JointJump, k + 2, top, limit);
@@ -287,12 +288,12 @@ fn without_t_the_segment_time_comes_from_durations_then_the_feed() {
     assert!(speed_findings(&found).is_empty(), "{found:?}");
 }
 
-/// The tool tip at the joints' midpoint, in the assembly mode of the working configuration
-/// nearest `near`.
-fn midpoint_tip(m: &Machine, a: &Joints, b: &Joints, near: &Vector3<f64>) -> Vector3<f64> {
-    let rho = a.rho + (b.rho - a.rho) * 0.5;
-    let q1 = a.theta1 + (b.theta1 - a.theta1) * 0.5;
-    let q2 = a.theta2 + (b.theta2 - a.theta2) * 0.5;
+/// The tool tip of the joints at fraction `s` of a segment, in the assembly mode of the
+/// working configuration nearest `near` (the complete forward kinematics, no tracking).
+fn tip_at(m: &Machine, a: &Joints, b: &Joints, s: f64, near: &Vector3<f64>) -> Vector3<f64> {
+    let rho = a.rho + (b.rho - a.rho) * s;
+    let q1 = a.theta1 + (b.theta1 - a.theta1) * s;
+    let q2 = a.theta2 + (b.theta2 - a.theta2) * s;
     machine_fk(m, &rho, q1, q2, m.tool_length)
         .iter()
         .filter(|md| md.config == WORKING_CONFIG)
@@ -301,14 +302,27 @@ fn midpoint_tip(m: &Machine, a: &Joints, b: &Joints, near: &Vector3<f64>) -> Vec
         .unwrap()
 }
 
+/// The chordal error is the largest distance, over the segment, of the interpolated joints' tip
+/// from the intended tip at the same fraction (the line, travelled uniformly): within a
+/// thousandth of an independent dense scan (400 points, the complete forward kinematics).
 #[test]
-fn the_chordal_error_is_the_midpoint_tip_off_the_line() {
+fn the_chordal_error_is_the_largest_tip_off_the_intended_move() {
     let m = Machine::default_verne();
     let (joints, path) = clean();
+    // The deviation at s, less the ends' own errors interpolated (docs/verify.md).
     let chords: Vec<f64> = (0..ROWS - 1)
         .map(|k| {
-            let mid = (path[k].tip + path[k + 1].tip) * 0.5;
-            (midpoint_tip(&m, &joints[k], &joints[k + 1], &mid) - mid).norm()
+            let err = |s: f64| {
+                let want = path[k].tip + (path[k + 1].tip - path[k].tip) * s;
+                tip_at(&m, &joints[k], &joints[k + 1], s, &want) - want
+            };
+            let (e0, e1) = (err(0.0), err(1.0));
+            (0..=400)
+                .map(|i| {
+                    let s = i as f64 / 400.0;
+                    (err(s) - (e0 * (1.0 - s) + e1 * s)).norm()
+                })
+                .fold(0.0, f64::max)
         })
         .collect();
     // A limit of next to nothing: every segment, with its chord.
@@ -322,7 +336,10 @@ fn the_chordal_error_is_the_midpoint_tip_off_the_line() {
     let found = of(&found, Check::ChordError);
     assert_eq!(found.len(), ROWS - 1, "{found:?}");
     for (v, chord) in found.iter().zip(&chords) {
-        assert!((v.value - chord).abs() < 1e-9, "{v:?} vs {chord}");
+        assert!(
+            v.value >= chord - 1e-9 && v.value <= chord * 1.001 + 1e-9,
+            "{v:?} vs {chord}"
+        );
         assert_eq!(v.limit, tiny);
     }
     // The largest chord as the limit: nothing; one ulp under it: that segment.
@@ -347,7 +364,7 @@ fn the_chordal_error_is_the_midpoint_tip_off_the_line() {
     let chord = of(&found, Check::ChordError);
     assert_eq!(chord.len(), 1, "{found:?}");
     assert_eq!(chord[0].row, (k + 2).to_string());
-    assert!(chord[0].detail.contains("off the intended line"));
+    assert!(chord[0].detail.contains("off the intended move"));
     // A rapid move is not along the line: no chord.
     let mut rapid = path.clone();
     rapid[k + 1].rapid = true;
@@ -507,6 +524,7 @@ fn half_a_turn_of_theta2_through_the_table_normal_is_a_flip() {
             ("tip_error_mm", 50.0),
             ("axis_error_deg", 10.0),
             ("chord_error_mm", 100.0),
+            ("chord_axis_error_deg", 100.0),
         ]);
         let (_, found) = run(&m, &th, oks(&q), path.clone());
         let at31: Vec<&Violation> = found.iter().filter(|v| v.row == "31").collect();

@@ -6,6 +6,7 @@ use std::path::Path;
 
 use crate::engine::module_rows::{ModuleIkAll, ModuleIkWorking};
 use crate::error::VerneError;
+use crate::follow::post::{Post, PostOptions, PostReport, ScheduleLine};
 use crate::follow::write::{CsvRows, GcodeProgram, Halstreamer};
 use crate::follow::{FollowOptions, Follower, RowSink};
 use crate::table::CsvSource;
@@ -18,7 +19,10 @@ use crate::toolpath::open::{Format, Input};
 use crate::toolpath::resample::Resampler;
 use crate::toolpath::{ReaderReport, ToolpathSource};
 use verne::machine::{FirstRowChoice, first_decided_theta2};
+use verne::post::linearize::Tolerances;
+use verne::post::schedule::{Limiting, Limits};
 use verne::spec::Machine;
+use verne::verify::{JOINT_NAMES, Th, Thresholds};
 
 use super::{
     EXIT_OK, EXIT_ROWS_FAILED, Mechanism, inline_source, load_mechanism, progress_bar,
@@ -62,6 +66,25 @@ pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
                 "--format {format} writes one joint row per pose; it cannot be combined with --all"
             )));
         }
+        if args.linearize {
+            return Err(VerneError::Usage(format!(
+                "--format {format} is linearized by default (--no-linearize turns it off); --linearize is for CSV output"
+            )));
+        }
+    } else if args.no_linearize {
+        return Err(VerneError::Usage(
+            "--no-linearize is for --format gcode and halstreamer; CSV output is not linearized unless --linearize".into(),
+        ));
+    }
+    if args.all && args.linearize {
+        return Err(VerneError::Usage(
+            "--linearize follows one branch; it cannot be combined with --all".into(),
+        ));
+    }
+    if args.schedule_report.is_some() && args.format != OutputFormat::Gcode {
+        return Err(VerneError::Usage(
+            "--schedule-report reports the block times of a joint program: it goes with --format gcode".into(),
+        ));
     }
     crate::arg_values::spatial(&args.pose, "--pose", "XP,YP,ZP").map_err(VerneError::Usage)?;
     if !args.pose.is_empty() {
@@ -194,6 +217,41 @@ fn follow_path(
         }
     };
     let machine_for_travel = machine.clone();
+    let name = args
+        .common
+        .machine
+        .as_ref()
+        .map_or("<default>".to_string(), |p| p.display().to_string());
+    let thresholds = Thresholds::from_machine(&machine, &name)?;
+    let linearize = (args.linearize
+        || (program.is_some() && !args.no_linearize && args.period.is_none()))
+    .then(|| Tolerances {
+        tip_mm: args
+            .part
+            .chord_tol
+            .unwrap_or(thresholds.get(Th::ChordErrorMm)),
+        axis_rad: args
+            .axis_tol
+            .unwrap_or(thresholds.get(Th::ChordAxisErrorDeg))
+            .to_radians(),
+    });
+    let schedule = (args.format == OutputFormat::Gcode).then(|| Limits::of(&machine.drives));
+    let post_machine = machine.clone();
+    let mut post = (linearize.is_some() || schedule.is_some()).then(|| {
+        let mut p = Post::new(
+            &post_machine,
+            tool_length,
+            offset,
+            PostOptions {
+                linearize,
+                schedule,
+            },
+        );
+        if args.schedule_report.is_some() {
+            p.schedule_lines = Some(Vec::new());
+        }
+        p
+    });
     let mut follower = Follower::new(FollowOptions {
         machine,
         tool_length,
@@ -210,7 +268,13 @@ fn follow_path(
         }
     };
     let started = std::time::Instant::now();
-    let result = crate::follow::run(&mut source, &mut follower, sink.as_mut(), &tick);
+    let result = crate::follow::run(
+        &mut source,
+        &mut follower,
+        post.as_mut(),
+        sink.as_mut(),
+        &tick,
+    );
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
@@ -226,8 +290,22 @@ fn follow_path(
         }
         return Err(e);
     }
-    sink.finish()?;
+    let not_linearized = post
+        .as_ref()
+        .is_some_and(|p| !p.report.not_linearized.is_empty());
+    if not_linearized && program.is_some() {
+        // Never a silently worse program: nothing is written, the moves are named.
+        sink.discard();
+    } else {
+        sink.finish()?;
+    }
     let name = source.name().to_string();
+    if let Some(p) = &mut post {
+        if let (Some(path), Some(lines)) = (&args.schedule_report, p.schedule_lines.take()) {
+            write_schedule_report(path, &lines)?;
+        }
+        report_post("ik", &name, &p.report, program.is_some());
+    }
     let summary = &follower.summary;
     report("ik", &name, summary);
     let cam_job = match source.report() {
@@ -258,11 +336,60 @@ fn follow_path(
         summary.ok_rows,
         summary.input_rows as f64 / seconds.max(1e-9)
     );
-    Ok(if summary.all_ok() {
+    Ok(if summary.all_ok() && !not_linearized {
         EXIT_OK
     } else {
         EXIT_ROWS_FAILED
     })
+}
+
+/// The post's summary on stderr: the blocks inserted, the cycle time against the feeds' alone,
+/// the blocks the drives slowed, and every move that could not be linearized.
+fn report_post(cmd: &str, name: &str, r: &PostReport, program: bool) {
+    if r.inserted > 0 || !r.not_linearized.is_empty() {
+        sayln!(
+            "verne {cmd}: {name}: linearized: {} rows, {} poses inserted",
+            r.rows,
+            r.inserted
+        );
+    }
+    if r.timed_blocks > 0 {
+        sayln!(
+            "verne {cmd}: {name}: scheduled: {} feed blocks in {:.3} s ({:.3} s at the programmed feeds alone); {} blocks slowed by the drives' limits",
+            r.timed_blocks,
+            r.time_s,
+            r.feed_time_s,
+            r.slowed
+        );
+    }
+    for (line, why) in &r.not_linearized {
+        sayln!("verne {cmd}: {name}:{line}: not linearized: {why}");
+    }
+    if !r.not_linearized.is_empty() && program {
+        sayln!(
+            "verne {cmd}: {name}: no program written: {} moves cannot be linearized within the tolerances (exit 1)",
+            r.not_linearized.len()
+        );
+    }
+}
+
+/// Writes the schedule report (CSV, atomically).
+fn write_schedule_report(path: &Path, lines: &[ScheduleLine]) -> Result<(), VerneError> {
+    let mut text = String::from("block,line,limit,share,feed_time_s,time_s\n");
+    for l in lines {
+        let limit = match l.limit {
+            Limiting::Feed => "feed".to_string(),
+            Limiting::Velocity(j) => format!("{}_velocity", JOINT_NAMES[j]),
+            Limiting::Acceleration(j) => format!("{}_acceleration", JOINT_NAMES[j]),
+        };
+        text.push_str(&format!(
+            "{},{},{limit},{:.6},{},{}\n",
+            l.block, l.line, l.share, l.feed_time_s, l.time_s
+        ));
+    }
+    crate::table::check_output_path(path)
+        .and_then(|_| crate::table::write_output(path, text.as_bytes()))
+        .map_err(|e| VerneError::io(&path.display().to_string(), e))
 }
 
 /// Whether the output goes to stdout.

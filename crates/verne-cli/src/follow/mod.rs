@@ -4,6 +4,7 @@
 //! the one before is solved (every branch of each row in parallel, then the branch chosen in
 //! order, nearest the previous row) and the one before that is written.
 
+pub mod post;
 pub mod write;
 
 use arrayvec::ArrayVec;
@@ -45,7 +46,11 @@ pub enum RowResult {
 #[derive(Debug, Clone)]
 pub struct Followed {
     pub row: PoseRow,
+    /// The 1-based row of the path it is (or, for a pose the post inserted, leads to).
+    pub path_row: u64,
     pub result: RowResult,
+    /// The time of the move to this row (s), when the post scheduled it.
+    pub time: Option<f64>,
 }
 
 impl Followed {
@@ -362,12 +367,14 @@ impl Follower {
 /// Progress callback: rows done so far.
 pub type Progress<'a> = &'a (dyn Fn(u64) + Sync);
 
-/// Follows the path of `source` into `sink`: reads, solves and writes batch by batch. A fatal
-/// error stops the run (the caller discards the sink); rows without joints are written with
-/// their status and counted.
+/// Follows the path of `source` into `sink` through the post's stages (`post`, when the output
+/// is linearized or timed): reads, solves and writes batch by batch. A fatal error stops the run
+/// (the caller discards the sink); rows without joints are written with their status and
+/// counted.
 pub fn run(
     source: &mut dyn ToolpathSource,
     follower: &mut Follower,
+    mut post: Option<&mut post::Post<'_>>,
     sink: &mut dyn RowSink,
     progress: Progress<'_>,
 ) -> Result<(), VerneError> {
@@ -376,7 +383,8 @@ pub fn run(
     let file = source.name().to_string();
     let mut finished = false;
     let sink_ref = &mut *sink;
-    verne::stream::run_batches(
+    let post_ref = &mut post;
+    verne::stream::run_batches::<_, VerneError, _, _, _>(
         [Batch::default(), Batch::default(), Batch::default()],
         |batch: &mut Batch| {
             batch.rows.clear();
@@ -407,9 +415,18 @@ pub fn run(
             batch.out.clear();
             for (row, solved) in batch.rows.drain(..).zip(&batch.solved) {
                 let result = follower.choose(&row, solved);
-                let followed = Followed { row, result };
+                let followed = Followed {
+                    row,
+                    path_row: follower.summary.input_rows + 1,
+                    result,
+                    time: None,
+                };
                 follower.count(&followed, every_row, &file)?;
                 batch.out.push(followed);
+            }
+            if let Some(p) = post_ref.as_deref_mut() {
+                let rows = std::mem::take(&mut batch.out);
+                batch.out = p.process(rows, &file)?;
             }
             progress(follower.summary.input_rows);
             Ok(())
@@ -419,5 +436,10 @@ pub fn run(
             batch.spare.extend(batch.out.drain(..).map(|f| f.row));
             Ok(())
         },
-    )
+    )?;
+    if let Some(p) = post {
+        let rest = p.finish();
+        sink.write(&rest)?;
+    }
+    Ok(())
 }

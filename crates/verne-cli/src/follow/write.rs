@@ -71,11 +71,17 @@ fn computed_rows(f: &Followed, n: usize, mut row: impl FnMut(&[Cell])) {
     let mut cells = ArrayVec::<Cell, 16>::new();
     match &f.result {
         RowResult::Joints(r) => {
-            let flags = match (r.near_rotary_singularity, r.switched) {
-                (true, true) => "near_rotary_singularity;orientation_switch",
-                (true, false) => "near_rotary_singularity",
-                (false, true) => "orientation_switch",
-                (false, false) => "",
+            let flags = match (
+                r.near_rotary_singularity,
+                r.switched,
+                f.row.fraction.is_some(),
+            ) {
+                (_, _, true) if r.near_rotary_singularity => "inserted;near_rotary_singularity",
+                (_, _, true) => "inserted",
+                (true, true, false) => "near_rotary_singularity;orientation_switch",
+                (true, false, false) => "near_rotary_singularity",
+                (false, true, false) => "orientation_switch",
+                (false, false, false) => "",
             };
             cells.extend([
                 Cell::Num(r.rho.x),
@@ -170,7 +176,11 @@ impl CsvRows {
                 match *slot {
                     Slot::Input(c) => {
                         let column = &columns[c];
-                        match (column.cell.and_then(|i| cells.get(i)), column.field) {
+                        let cell = column.cell.and_then(|i| cells.get(i));
+                        // A pose the post inserted writes its own pose, the rest as its row's.
+                        let cell =
+                            cell.filter(|_| f.row.fraction.is_none() || column.field.is_none());
+                        match (cell, column.field) {
                             (Some(cell), _) => encode_field(buf, b',', k == 0, cell),
                             (None, Some(field)) => {
                                 write_value(buf, b',', k == 0, f.row.value(field, units.radians))
@@ -295,21 +305,21 @@ impl RowSink for Halstreamer {
 /// Joint words are written with this many decimals (mm and degrees): 1 nm, 1e-6 degree.
 pub const DECIMALS: usize = 6;
 
-/// The F of a block that does not move (inverse time, 1/min): 1 ms.
-const STILL_F: f64 = 60_000.0;
+/// Significant digits of a feed word (inverse time): its block's time to 1 part in 1e9.
+const FEED_DIGITS: i32 = 9;
 
 /// A joint program: one G-code block per pose, the five joints by the letters of the machine
-/// file's `[gcode]` table, `G0` for rapids, and for feed moves `G93` inverse time, so that each
-/// block takes the time of the tool tip's move at the path's feed (LinuxCNC's rule for moves of
-/// the rotary axes alone: their angle at the feed in degrees per minute), or the time the path
-/// states for the move (a tool-centre program's `G93` block, a `dt` cell). `verne verify
-/// --joints` reads it back, one row per block.
+/// file's `[gcode]` table, `G0` for rapids and for feed moves `G93` inverse time: each block
+/// takes the time the post scheduled for it (within the drives' limits and the path's feeds,
+/// [`super::post`]). Every block has its own `N` word, and a comment naming the toolpath line
+/// it leads to (with the fraction of that move, for a pose the post inserted): `verne verify
+/// --joints` pairs the blocks with the path by it.
 pub struct GcodeProgram {
     sink: Sink,
     words: GcodeWords,
     source: String,
-    prev_tip: Option<[f64; 3]>,
-    prev_angles: [f64; 2],
+    /// Blocks written.
+    blocks: u64,
     block: Vec<u8>,
 }
 
@@ -324,8 +334,7 @@ impl GcodeProgram {
             sink: Sink::create(path)?,
             words,
             source: source.to_string(),
-            prev_tip: None,
-            prev_angles: [0.0; 2],
+            blocks: 0,
             block: Vec::with_capacity(1 << 16),
         })
     }
@@ -336,7 +345,6 @@ impl GcodeProgram {
             return Ok(());
         };
         let row = &f.row;
-        let tip = [row.tip.x, row.tip.y, row.tip.z];
         let joints = [
             r.rho.x,
             r.rho.y,
@@ -344,54 +352,39 @@ impl GcodeProgram {
             r.theta1.to_degrees(),
             r.theta2.to_degrees(),
         ];
-        let rapid = row.rapid() || self.prev_tip.is_none();
         let out = &mut self.block;
-        // N: the toolpath's own line (a G-code program's N word when it has one).
-        let _ = write!(out, "N{} ", row.n.unwrap_or(row.line));
-        out.extend_from_slice(if rapid { b"G0" } else { b"G1" });
+        self.blocks += 1;
+        let _ = write!(out, "N{} ", self.blocks);
+        out.extend_from_slice(if f.time.is_some() { b"G1" } else { b"G0" });
         for (w, v) in self.words.joints.iter().zip(joints) {
             let _ = write!(out, " {}{}", w.letter, number(w.word(v)));
         }
-        if !rapid {
-            let minutes = match row.dt {
-                // The path states the move's time (a G93 block, a `dt` cell).
-                Some(seconds) => seconds / 60.0,
-                None => {
-                    let feed = row.feed.filter(|f| f.is_finite() && *f > 0.0).ok_or_else(|| {
-                        VerneError::input(
-                            &self.source,
-                            Some(row.line),
-                            None,
-                            "a feed move without a feed: --format gcode times each feed move by the path's feed (a CL file's FEDRAT, a program's F, a `feed` column)",
-                        )
-                    })?;
-                    let prev = self.prev_tip.unwrap_or(tip);
-                    let length = (0..3)
-                        .map(|k| (tip[k] - prev[k]).powi(2))
-                        .sum::<f64>()
-                        .sqrt();
-                    // The tip's path at the feed, or, when the tip stays, the table's angles at
-                    // the feed in degrees per minute (LinuxCNC's rule for A B C).
-                    let turn = ((joints[3] - self.prev_angles[0]).powi(2)
-                        + (joints[4] - self.prev_angles[1]).powi(2))
-                    .sqrt();
-                    if length > 1e-9 {
-                        length / feed
-                    } else {
-                        turn / feed
-                    }
-                }
-            };
-            let f = if minutes > 0.0 {
-                1.0 / minutes
-            } else {
-                STILL_F
-            };
-            let _ = write!(out, " F{}", number(f));
+        if let Some(seconds) = f.time {
+            let feed = feed_word(60.0 / seconds).ok_or_else(|| {
+                VerneError::input(
+                    &self.source,
+                    Some(row.line),
+                    None,
+                    format!("the move takes {seconds:e} s: more than G93's inverse time can state (a feed too small?)"),
+                )
+            })?;
+            let _ = write!(out, " F{feed}");
+        }
+        match row.fraction {
+            Some(s) => {
+                let _ = write!(
+                    out,
+                    " (path row {} at {} line {})",
+                    f.path_row,
+                    fraction_text(s),
+                    row.line
+                );
+            }
+            None => {
+                let _ = write!(out, " (path row {} line {})", f.path_row, row.line);
+            }
         }
         out.push(b'\n');
-        self.prev_tip = Some(tip);
-        self.prev_angles = [joints[3], joints[4]];
         Ok(())
     }
 }
@@ -400,7 +393,7 @@ impl RowSink for GcodeProgram {
     fn begin(&mut self, _: &[Column]) -> Result<(), VerneError> {
         let w = &self.words.joints;
         let text = format!(
-            "%\n(joint program for the VERNE machine, written by verne ik --format gcode from {})\n({} = rho1, {} = rho2, {} = rho3 in mm; {} = theta1, {} = theta2 in degrees: the machine file's [gcode] table)\n(N = the line of the toolpath; G93: each feed block takes the time of the tool tip's move at the path's feed)\nG21 G90 G17 G40 G49 G80 G93\n",
+            "%\n(joint program for the VERNE machine, written by verne ik --format gcode from {})\n({} = rho1, {} = rho2, {} = rho3 in mm; {} = theta1, {} = theta2 in degrees: the machine file's [gcode] table)\n(each block: its number N, and the path row and line it leads to, with the fraction of that move for a pose inserted by the post)\n(G93: each feed block takes its time within the drives' limits and the path's feeds)\nG21 G90 G17 G40 G49 G80 G93\n",
             comment_safe(&self.source),
             w[0].letter,
             w[1].letter,
@@ -433,6 +426,34 @@ impl RowSink for GcodeProgram {
     }
 }
 
+/// An inverse-time feed word with [`FEED_DIGITS`] significant digits, rounded down (the block
+/// takes no less than its time), trailing zeros dropped; `None` when it would read 0.
+fn feed_word(f: f64) -> Option<String> {
+    if !(f.is_finite() && f > 0.0) {
+        return None;
+    }
+    let e = f.log10().floor() as i32;
+    let decimals = (FEED_DIGITS - 1 - e).clamp(0, 12);
+    let scale = 10f64.powi(decimals);
+    let down = (f * scale).floor() / scale;
+    if down <= 0.0 {
+        return None;
+    }
+    let s = format!("{down:.*}", decimals as usize);
+    let s = if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        &s
+    };
+    Some(s.to_string())
+}
+
+/// A fraction of a move, as short as it reads back within 1e-6.
+fn fraction_text(s: f64) -> String {
+    let t = format!("{s:.6}");
+    t.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
 /// A number with [`DECIMALS`] decimals, trailing zeros dropped (`12.5`, `-0.000001`, `3`).
 fn number(v: f64) -> String {
     let s = format!("{v:.DECIMALS$}");
@@ -458,6 +479,22 @@ fn comment_safe(s: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn feed_words_round_down_to_nine_digits() {
+        assert_eq!(feed_word(1234.56789012).as_deref(), Some("1234.56789"));
+        assert_eq!(
+            feed_word(0.000123456789123).as_deref(),
+            Some("0.000123456789")
+        );
+        assert_eq!(feed_word(60.0).as_deref(), Some("60"));
+        assert_eq!(feed_word(1e-14), None);
+        assert_eq!(feed_word(0.0), None);
+        for f in [1.0 / 3.0, 2.0f64.sqrt() * 1e5, 7.77e-3] {
+            let w: f64 = feed_word(f).unwrap().parse().unwrap();
+            assert!(w <= f && w > f * (1.0 - 1e-8), "{f} -> {w}");
+        }
+    }
 
     #[test]
     fn numbers_and_comments() {

@@ -13,7 +13,7 @@ use std::io::{BufRead, Write};
 
 use verne::parallel_module::equations::Sliders;
 use verne::spec::gcode::{GcodeOrientation, GcodeWords, JOINT_KEYS};
-use verne::verify::{Item, JointSource, Joints, RowSource};
+use verne::verify::{Item, JointSource, Joints, PathTag, RowSource};
 use verne_gcode::{AXES, Axis, GcodeError, Motion, Options, Reader, Summary};
 
 use crate::error::VerneError;
@@ -168,6 +168,7 @@ impl RowSource for JointProgram {
             index: self.index,
             line: row.line,
             id: row.n.map(|n| format!("N{n}")),
+            tag: row.comment.as_ref().and_then(|c| path_tag(c.as_str())),
             value: Ok(Joints {
                 rho: Sliders::new(v[0], v[1], v[2]),
                 theta1: v[3],
@@ -181,9 +182,36 @@ impl RowSource for JointProgram {
     }
 }
 
+/// The path row a block's comment names, as `verne ik --format gcode` writes it: `path row R
+/// line L` for the row itself, `path row R at S line L` for a pose inserted at fraction S of the
+/// move to it. Any other comment names none.
+pub fn path_tag(comment: &str) -> Option<PathTag> {
+    let rest = comment.strip_prefix("path row ")?;
+    let mut words = rest.split_ascii_whitespace();
+    let row: u64 = words.next()?.parse().ok()?;
+    let fraction = match words.next()? {
+        "at" => {
+            let f: f64 = words.next()?.parse().ok()?;
+            (f.is_finite() && (0.0..=1.0).contains(&f)).then_some(f)?;
+            if words.next()? != "line" {
+                return None;
+            }
+            Some(f)
+        }
+        "line" => None,
+        _ => return None,
+    };
+    Some(PathTag { row, fraction })
+}
+
 impl JointSource for JointProgram {
     /// A program's feed moves are timed by its feeds.
     fn timed(&self) -> bool {
+        true
+    }
+
+    /// The controller starts still, and stops at a rapid and at the program's end.
+    fn starts_at_rest(&self) -> bool {
         true
     }
 }

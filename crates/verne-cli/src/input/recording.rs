@@ -161,6 +161,7 @@ impl RowSource for RecordingReader {
                 line: self.line,
                 id: None,
                 value,
+                tag: None,
             };
             if fields == ["overrun"] {
                 // halsampler lost samples here: the times around it are not a servo period apart.

@@ -225,6 +225,7 @@ impl RowSource for JointReader {
             line,
             id,
             value,
+            tag: None,
         }))
     }
 }
@@ -259,6 +260,7 @@ impl RowSource for PathReader {
             line: r.line,
             id: r.id.clone(),
             value: r.path_point(&self.offset),
+            tag: None,
         }))
     }
 }
@@ -329,6 +331,13 @@ impl JointSource for JointInput {
         match self {
             JointInput::Csv(r) => r.timed(),
             JointInput::Gcode(p) => p.timed(),
+        }
+    }
+
+    fn starts_at_rest(&self) -> bool {
+        match self {
+            JointInput::Csv(r) => r.starts_at_rest(),
+            JointInput::Gcode(p) => p.starts_at_rest(),
         }
     }
 }

@@ -100,6 +100,7 @@ impl ToolpathSource for ClToolpath {
                 row.stated_angles = None;
                 row.invalid = None;
                 row.cells.clear();
+                row.fraction = None;
                 Ok(true)
             }
             Some(Err(e)) => Err(cl_error(&self.name, &e)),

@@ -176,6 +176,7 @@ impl ToolpathSource for CsvToolpath {
         };
         row.invalid = invalid;
         row.cells = rec;
+        row.fraction = None;
         Ok(true)
     }
 }

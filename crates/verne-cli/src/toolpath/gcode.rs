@@ -5,7 +5,7 @@
 //! line, never ignored.
 
 use nalgebra::Vector3;
-use verne::machine::orientation::{ToolOrientation, tool_axis};
+use verne::machine::orientation::{ToolAngles, ToolOrientation, tool_axis};
 use verne::spec::gcode::{GcodeOrientation, GcodeWords};
 use verne_gcode::{Axis, Motion as GcodeMotion};
 
@@ -146,10 +146,16 @@ impl ToolpathSource for TcpToolpath {
         row.tool = r.tool;
         row.id = None;
         row.tip = Vector3::new(r.get(Axis::X), r.get(Axis::Y), r.get(Axis::Z));
-        row.orientation = ToolOrientation::Axis(axis);
+        // The program's angles as it states them (the controller of a tool-centre program
+        // moves them), else its axis.
+        row.orientation = match angles {
+            Some((phi1, phi2)) => ToolOrientation::Angles(ToolAngles { phi1, phi2 }),
+            None => ToolOrientation::Axis(axis),
+        };
         row.stated_angles = angles;
         row.invalid = None;
         row.cells.clear();
+        row.fraction = None;
         Ok(true)
     }
 

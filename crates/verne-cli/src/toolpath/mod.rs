@@ -160,6 +160,9 @@ pub struct PoseRow {
     pub invalid: Option<String>,
     /// A CSV input's own cells, passed through to CSV output; empty for other readers.
     pub cells: ByteRecord,
+    /// For a pose the post inserted (not a row of the input): the fraction of the move to the
+    /// row of `line` it lies at.
+    pub fraction: Option<f64>,
 }
 
 impl Default for PoseRow {
@@ -179,6 +182,7 @@ impl Default for PoseRow {
             stated_angles: None,
             invalid: None,
             cells: ByteRecord::new(),
+            fraction: None,
         }
     }
 }

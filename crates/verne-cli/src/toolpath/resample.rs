@@ -145,6 +145,7 @@ impl<S: ToolpathSource> Resampler<S> {
         };
         out.invalid = None;
         out.cells.clear();
+        out.fraction = None;
     }
 
     /// The pose of a row of the input, or why it has none.

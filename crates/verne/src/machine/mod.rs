@@ -21,6 +21,7 @@ use nalgebra::Vector3;
 
 pub mod fk;
 pub mod ik;
+pub mod intended;
 pub mod orientation;
 pub mod path;
 pub mod transforms;

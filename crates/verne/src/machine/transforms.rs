@@ -6,6 +6,7 @@ use std::f64::consts::PI;
 
 use nalgebra::{Matrix4, Vector3, Vector4};
 
+use crate::math::interval::Iv;
 use crate::parallel_module::equations::ModulePose;
 use crate::parallel_module::ik::wrap_angle;
 use crate::spec::TableGeometry;
@@ -71,6 +72,59 @@ pub fn tool_pose_eq26(
         tip: Vector3::new(c2 * xp + v1 * s2, -s2 * xp + v1 * c2, s1 * yp + v2),
         phi1: wrap_angle(d),
         phi2: wrap_angle(-theta2),
+    }
+}
+
+/// The tool pose of eq. (26), AIM 2007, and its rate along a move, over intervals: the tip,
+/// the tool axis (eq. (8), with phi1 = alpha - theta1, phi2 = -theta2) and their derivatives
+/// d/ds, for every module pose in `pose` (x, y, z, alpha) with rate `rate`, and table angles in
+/// `theta` moving at `dtheta` per unit of s.
+pub struct ToolPoseOver {
+    pub tip: [Iv; 3],
+    pub tip_rate: [Iv; 3],
+    pub axis: [Iv; 3],
+    pub axis_rate: [Iv; 3],
+}
+
+/// [`tool_pose_eq26`] and its derivative along a move, enclosed (see [`ToolPoseOver`]).
+pub fn tool_pose_over(
+    table: &TableGeometry,
+    pose: &[Iv; 4],
+    rate: &[Iv; 4],
+    theta: [Iv; 2],
+    dtheta: [f64; 2],
+    tool_length: f64,
+) -> ToolPoseOver {
+    let p = Iv::point;
+    let [xp, yp, zp, alpha] = *pose;
+    let [dxp, dyp, dzp, dalpha] = *rate;
+    let (s1, c1) = theta[0].sin_cos();
+    let (s2, c2) = theta[1].sin_cos();
+    let (t1, t2) = (p(dtheta[0]), p(dtheta[1]));
+    let d = alpha - theta[0];
+    let dd = dalpha - t1;
+    let (sd, cd) = d.sin_cos();
+    let l = p(tool_length);
+    let da = p(table.d_a);
+    // eq. (26): v1 = L sin d - c1 yp - s1 (zp - d_a), v2 = d_t - c1 zp + d_a c1 - L cos d.
+    let v1 = l * sd - c1 * yp - s1 * (zp - da);
+    let v2 = p(table.d_t) - c1 * zp + da * c1 - l * cd;
+    let dv1 = l * cd * dd + s1 * t1 * yp - c1 * dyp - c1 * t1 * (zp - da) - s1 * dzp;
+    let dv2 = s1 * t1 * zp - c1 * dzp - da * s1 * t1 + l * sd * dd;
+    ToolPoseOver {
+        tip: [c2 * xp + v1 * s2, -(s2 * xp) + v1 * c2, s1 * yp + v2],
+        tip_rate: [
+            -(s2 * t2 * xp) + c2 * dxp + dv1 * s2 + v1 * c2 * t2,
+            -(c2 * t2 * xp) - s2 * dxp + dv1 * c2 - v1 * s2 * t2,
+            c1 * t1 * yp + s1 * dyp + dv2,
+        ],
+        // a = (sin phi1 sin phi2, -sin phi1 cos phi2, cos phi1) with phi2 = -theta2.
+        axis: [-(sd * s2), -(sd * c2), cd],
+        axis_rate: [
+            -(cd * dd * s2) - sd * c2 * t2,
+            -(cd * dd * c2) + sd * s2 * t2,
+            -(sd * dd),
+        ],
     }
 }
 

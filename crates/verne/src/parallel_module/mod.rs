@@ -13,6 +13,7 @@
 //!   decide.
 
 pub mod branches;
+pub mod enclosure;
 pub mod equations;
 pub mod fk;
 pub mod fk_certify;

@@ -6,6 +6,7 @@
 
 use std::collections::{HashMap, HashSet};
 
+use super::drives::Drives;
 use super::gcode::{GcodeValue, GcodeWords};
 use super::{Limits, Machine, ModuleGeometry, TableGeometry};
 use crate::error::{MachineError, Problem};
@@ -407,7 +408,7 @@ impl Machine {
         let m = &self.module;
         let l = &self.limits;
         format!(
-            "kind = \"verne\"\nname = {:?}\n\n[module]\nD1 = {}\nd1 = 0.0\nR1 = {}\nr1 = {}\nL1 = {}\nD2 = {}\nd2 = 0.0\nR2 = {}\nr4 = {}\nL2 = {}\nL3 = {}\n\n[limits]\nrho1_min = {}\nrho1_max = {}\nrho2_min = {}\nrho2_max = {}\nrho3_min = {}\nrho3_max = {}\nrod_tilt_max = {}\ntheta1_min = {}\ntheta1_max = {}\n\n[table]\nd_a = {}\nd_t = {}\n\n[tool]\nlength = {}\n\n{}",
+            "kind = \"verne\"\nname = {:?}\n\n[module]\nD1 = {}\nd1 = 0.0\nR1 = {}\nr1 = {}\nL1 = {}\nD2 = {}\nd2 = 0.0\nR2 = {}\nr4 = {}\nL2 = {}\nL3 = {}\n\n[limits]\nrho1_min = {}\nrho1_max = {}\nrho2_min = {}\nrho2_max = {}\nrho3_min = {}\nrho3_max = {}\nrod_tilt_max = {}\ntheta1_min = {}\ntheta1_max = {}\n\n[table]\nd_a = {}\nd_t = {}\n\n[tool]\nlength = {}\n\n{}\n{}",
             self.name,
             m.dx1,
             m.r_big1,
@@ -430,6 +431,7 @@ impl Machine {
             self.table.d_a,
             self.table.d_t,
             self.tool_length,
+            self.drives.to_toml(),
             self.gcode.to_toml()
         )
     }
@@ -560,7 +562,9 @@ fn entries_of(text: &str, source: &str) -> Result<(Vec<Entry>, Vec<Problem>), Ma
 /// Sections that are not tables, or unknown sections, are reported once.
 fn check_sections(table: &toml::Table, lines: &TomlLines) -> Vec<Problem> {
     let mut out = Vec::new();
-    for section in ["module", "limits", "table", "tool", "verify", "gcode"] {
+    for section in [
+        "module", "limits", "table", "tool", "drives", "verify", "gcode",
+    ] {
         if let Some(v) = table.get(section)
             && !v.is_table()
         {
@@ -613,6 +617,7 @@ fn finish(
     let mut values = [f64::NAN; SCHEMA.len()];
     let mut kind_seen = false;
     let mut verify = Vec::new();
+    let mut drives = Vec::new();
     let mut gcode = Vec::new();
     let mut name = String::from("unnamed");
     // Unknown and duplicated keys.
@@ -651,6 +656,17 @@ fn finish(
                 Value::Other(_) => GcodeValue::Other,
             };
             gcode.push((key.to_string(), value, e.line));
+            continue;
+        }
+        if let Some(name) = e.key.strip_prefix("drives.") {
+            match &e.value {
+                Value::Number(x) => drives.push((name.to_string(), *x, e.line)),
+                _ => problems.push(Problem {
+                    line: e.line,
+                    key: e.key.clone(),
+                    message: "expected a positive number (a drive limit)".into(),
+                }),
+            }
             continue;
         }
         if let Some(name) = e.key.strip_prefix("verify.") {
@@ -738,6 +754,7 @@ fn finish(
         values[pos] = x;
     }
     let gcode = GcodeWords::from_entries(&gcode, &mut problems);
+    let drives = Drives::from_entries(&drives, &mut problems);
     if !kind_seen {
         problems.push(Problem {
             line: None,
@@ -789,6 +806,7 @@ fn finish(
             d_t: v(21),
         },
         tool_length: v(22),
+        drives,
         verify,
         gcode,
     };

@@ -1,6 +1,7 @@
 //! Machine parameters: the geometry, limits and tool of a VERNE-type machine ([`Machine`]) and
 //! its machine file (TOML or two-column CSV, [`file`]: schema, reading and validation).
 
+pub mod drives;
 mod file;
 pub mod gcode;
 
@@ -55,6 +56,9 @@ pub struct Machine {
     pub table: TableGeometry,
     /// Tool length Delta (mm), AIM 2007 eq. (8).
     pub tool_length: f64,
+    /// The `[drives]` table (optional, with assumed defaults): each joint's largest speed and
+    /// acceleration, and the rapid rate.
+    pub drives: drives::Drives,
     /// The optional `[verify]` table: thresholds of `verne verify` by name, as written (the
     /// verify module checks the names and values).
     pub verify: Vec<(String, f64, Option<usize>)>,

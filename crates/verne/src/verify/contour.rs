@@ -353,6 +353,7 @@ impl<E> RowSource for Projected<'_, E> {
             line: self.index,
             id: None,
             value: Ok(point),
+            tag: None,
         }))
     }
 }

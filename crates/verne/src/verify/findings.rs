@@ -23,8 +23,14 @@ pub enum Check {
     Limits,
     /// Check 5: velocity amplification factors or parallel margin, at a row or along a segment.
     Singularity,
-    /// Check 3: chordal error at the segment's midpoint (mm).
+    /// Check 3: the tool tip of the interpolated joints from the intended move's, along the
+    /// segment (mm).
     ChordError,
+    /// Check 3: the tool axis of the interpolated joints from the intended move's, along the
+    /// segment (deg).
+    ChordAxis,
+    /// The joint program moves rapid (`G0`) where the intended path cuts.
+    Motion,
     /// Check 6: joint change between two rows above its limit.
     JointJump,
     /// Check 6: theta2 turns by about half a turn between two rows.
@@ -36,13 +42,15 @@ pub enum Check {
 }
 
 impl Check {
-    pub const ALL: [Check; 12] = [
+    pub const ALL: [Check; 14] = [
         Check::Input,
         Check::Pairing,
         Check::TipError,
         Check::AxisError,
         Check::Limits,
         Check::ChordError,
+        Check::ChordAxis,
+        Check::Motion,
         Check::Branch,
         Check::Singularity,
         Check::JointJump,
@@ -61,6 +69,8 @@ impl Check {
             Check::Limits => "limits",
             Check::Singularity => "singularity",
             Check::ChordError => "chord_error",
+            Check::ChordAxis => "chord_axis",
+            Check::Motion => "motion",
             Check::JointJump => "joint_jump",
             Check::Theta2Flip => "theta2_flip",
             Check::Velocity => "velocity",
@@ -94,6 +104,9 @@ pub struct Violation {
     pub detail: String,
     /// How far beyond the limit (>= 1, larger is worse): picks the worst finding of a check.
     pub severity: f64,
+    /// The line of the joint table (or program) the finding is at, and of the intended path.
+    pub joints_line: Option<u64>,
+    pub path_line: Option<u64>,
 }
 
 impl Violation {
@@ -115,6 +128,8 @@ impl Violation {
             } else {
                 f64::INFINITY
             },
+            joints_line: None,
+            path_line: None,
         }
     }
 
@@ -136,6 +151,8 @@ impl Violation {
             } else {
                 f64::INFINITY
             },
+            joints_line: None,
+            path_line: None,
         }
     }
 
@@ -147,6 +164,8 @@ impl Violation {
             limit: f64::NAN,
             detail,
             severity: 1.0,
+            joints_line: None,
+            path_line: None,
         }
     }
 }
@@ -199,7 +218,7 @@ impl Summary {
         }
     }
 
-    pub(super) fn observe(&mut self, o: &Obs, row: &str) {
+    pub(super) fn observe(&mut self, o: &Obs, row: &str, lines: (u64, Option<u64>)) {
         let s = &mut self.checks[o.check.slot()].1;
         if s.worst.as_ref().is_none_or(|w| o.severity > w.severity) {
             s.worst = Some(Violation {
@@ -209,6 +228,8 @@ impl Summary {
                 limit: o.limit,
                 detail: format!("{} (within the limit)", o.what),
                 severity: o.severity,
+                joints_line: Some(lines.0),
+                path_line: lines.1,
             });
         }
     }

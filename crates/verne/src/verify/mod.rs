@@ -33,6 +33,7 @@ use arrayvec::ArrayVec;
 use nalgebra::Vector3;
 
 use crate::error::shown;
+use crate::machine::intended::IntendedMove;
 use crate::machine::orientation::ROTARY_SINGULAR_CONE_RAD;
 use crate::machine::{MachineFkModes, machine_fk, tool_pose_eq26};
 use crate::par::*;
@@ -40,6 +41,7 @@ use crate::parallel_module::branches::{Config, Reason, WORKING_CONFIG, config_of
 use crate::parallel_module::equations::{ModulePose, Sliders, polish_pose, residual_mm, rod_tilts};
 use crate::parallel_module::ik::wrap_angle;
 use crate::parallel_module::kinetostatics::kinetostatics;
+use crate::post::schedule::vertex_acceleration;
 use crate::spec::Machine;
 use crate::tolerance::ACCEPT_RESIDUAL_MM;
 
@@ -195,6 +197,20 @@ pub struct Item<T> {
     pub line: u64,
     pub id: Option<String>,
     pub value: Result<T, String>,
+    /// For a block of a joint program that names the path row it leads to (as `verne ik
+    /// --format gcode` writes them): that row, and the fraction of the move to it for a pose
+    /// the post inserted. The program is then paired with the path by it.
+    pub tag: Option<PathTag>,
+}
+
+/// The path row a joint program's block leads to.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PathTag {
+    /// The path's 1-based data row.
+    pub row: u64,
+    /// The fraction of the move to that row (a pose inserted on the move), or `None` for the
+    /// row itself.
+    pub fraction: Option<f64>,
 }
 
 /// The joint columns of a joint table, in order (mm, mm, mm, degrees, degrees).
@@ -224,28 +240,19 @@ pub trait RowSource {
 pub trait JointSource: RowSource<Row = Joints> {
     /// True when velocities and accelerations can be checked.
     fn timed(&self) -> bool;
+    /// True when the machine is at rest before each run of timed moves and after it (a program
+    /// for the controller: it starts still, and stops at a rapid and at its end), so that the
+    /// accelerations into and out of those runs are checked too. A table of joints sampled
+    /// from a motion (a CSV with `t`, a recording) may start and end in motion: the default.
+    fn starts_at_rest(&self) -> bool {
+        false
+    }
 }
 
 /// Why the rows of the two inputs cannot be paired: a fatal error of the run, at a line of one
-/// of the inputs.
+/// of the inputs. (Rows of one input without a partner in the other are findings, not errors.)
 #[derive(Debug, Clone, PartialEq)]
 pub enum PairingError {
-    /// Without ids, the joint table goes on after the intended path ended.
-    ExtraJointRow {
-        joints: String,
-        path: String,
-        /// The joint row's line and 1-based data row.
-        line: u64,
-        index: u64,
-    },
-    /// Without ids, the intended path goes on after the joint table ended.
-    ExtraPathRow {
-        joints: String,
-        path: String,
-        /// The path row's line and 1-based data row.
-        line: u64,
-        index: u64,
-    },
     /// An id appears twice in one input (`file`: the joint table or the intended path).
     DuplicateId {
         file: String,
@@ -259,8 +266,6 @@ impl PairingError {
     /// The input the error is in.
     pub fn file(&self) -> &str {
         match self {
-            PairingError::ExtraJointRow { joints, .. } => joints,
-            PairingError::ExtraPathRow { path, .. } => path,
             PairingError::DuplicateId { file, .. } => file,
         }
     }
@@ -268,9 +273,7 @@ impl PairingError {
     /// The 1-based line of that input.
     pub fn line(&self) -> u64 {
         match self {
-            PairingError::ExtraJointRow { line, .. }
-            | PairingError::ExtraPathRow { line, .. }
-            | PairingError::DuplicateId { line, .. } => *line,
+            PairingError::DuplicateId { line, .. } => *line,
         }
     }
 
@@ -278,7 +281,6 @@ impl PairingError {
     pub fn column(&self) -> Option<&'static str> {
         match self {
             PairingError::DuplicateId { .. } => Some("id"),
-            _ => None,
         }
     }
 }
@@ -286,30 +288,6 @@ impl PairingError {
 impl fmt::Display for PairingError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            PairingError::ExtraJointRow {
-                path,
-                line: _,
-                index,
-                ..
-            } => write!(
-                f,
-                "the joint table has more rows than the intended path {} ({} rows): row {} has no intended row; expected one joint row per path row, or an `id` column in both files",
-                path,
-                index - 1,
-                index
-            ),
-            PairingError::ExtraPathRow {
-                joints,
-                line: _,
-                index,
-                ..
-            } => write!(
-                f,
-                "the intended path has more rows than the joint table {} ({} rows): path row {} has no joint row; expected one joint row per path row, or an `id` column in both files",
-                joints,
-                index - 1,
-                index
-            ),
             PairingError::DuplicateId {
                 id,
                 line,
@@ -329,8 +307,19 @@ impl fmt::Display for PairingError {
 impl std::error::Error for PairingError {}
 
 /// How the rows of the two files are matched.
+#[allow(clippy::large_enum_variant)] // one per run
 enum Pairer {
+    /// Before the first joint row: by tags if it has one, else in order.
+    Undecided,
     InOrder,
+    /// By the path row each block names ([`PathTag`]).
+    ByTag {
+        /// The last path row read, and whether a block landed on it.
+        current: Option<Item<PathPoint>>,
+        covered: bool,
+        /// The path row before it (the start of the move to it).
+        before: Option<Item<PathPoint>>,
+    },
     ById {
         /// Path rows read ahead, waiting for their joint row.
         pending: HashMap<String, Item<PathPoint>>,
@@ -363,6 +352,10 @@ struct Paired {
     point: Option<Item<PathPoint>>,
     /// The joint row's assembly modes, when the pairing computed them.
     modes: Option<Box<MachineFkModes>>,
+    /// Path rows passed over before this row without a joint row of their own.
+    missing: Vec<Item<PathPoint>>,
+    /// Why the row has no partner, when the pairing knows.
+    unpaired: Option<String>,
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -393,6 +386,9 @@ struct RowEval {
     singular_ok: bool,
     /// A pairing gap: no segment joins this row to the previous one.
     break_before: bool,
+    /// The joint row's line, and its intended row's.
+    joints_line: u64,
+    path_line: Option<u64>,
 }
 
 /// Per-segment result of the parallel solve, before the order-dependent checks.
@@ -400,9 +396,14 @@ struct RowEval {
 struct SegEval {
     violations: Vec<Violation>,
     obs: ArrayVec<Obs, 8>,
-    /// Joint rates (per s) when timed and within the velocity limits.
+    /// Joint rates (per s) when timed.
     rates: Option<[f64; 5]>,
+    /// The rates are within the velocity limits (and not a jump): the accelerations at the
+    /// segment's vertices are checked.
+    accelerations_checked: bool,
     dt: f64,
+    /// The joints' change over the segment.
+    dq: [f64; 5],
     /// Signed theta2 change (rad) when the segment is a theta2 flip.
     flip: Option<f64>,
 }
@@ -412,8 +413,82 @@ struct SegEval {
 struct PrevSeg {
     end_row: String,
     rates: Option<[f64; 5]>,
+    accelerations_checked: bool,
     dt: f64,
+    /// The joints' change over the segment.
+    dq: [f64; 5],
     flip: Option<f64>,
+    /// The lines of the row that ends it.
+    lines: (u64, Option<u64>),
+}
+
+/// `v` at the lines of its row, unless it names its own.
+fn with_lines(v: &Violation, (joints, path): (u64, Option<u64>)) -> Violation {
+    let mut v = v.clone();
+    v.joints_line = v.joints_line.or(Some(joints));
+    v.path_line = v.path_line.or(path);
+    v
+}
+
+/// The acceleration check of one vertex: the worst joint's observation, and a finding for
+/// each joint over its limit.
+fn acceleration_findings(
+    opt: &VerifyOptions,
+    acc: &[f64; 5],
+    label: &str,
+    where_: &str,
+) -> (Obs, Vec<Violation>) {
+    let amax =
+        opt.thresholds
+            .per_joint(Th::RhoAccelMmS2, Th::Theta1AccelDegS2, Th::Theta2AccelDegS2);
+    let mut worst = None;
+    let mut found = Vec::new();
+    for i in 0..5 {
+        let (v, l, u) = if i < 3 {
+            (acc[i].abs(), amax[i], "mm/s^2")
+        } else {
+            (acc[i].abs().to_degrees(), amax[i].to_degrees(), "deg/s^2")
+        };
+        keep_worst(
+            &mut worst,
+            Obs::over(Check::Acceleration, v, l, JOINT_NAMES[i]),
+        );
+        if acc[i].abs() > amax[i] {
+            found.push(Violation::over(
+                label,
+                Check::Acceleration,
+                v,
+                l,
+                format!("{} at {v:.4} {u} {where_}", JOINT_NAMES[i]),
+            ));
+        }
+    }
+    (worst.expect("five joints"), found)
+}
+
+/// The stop at the end of a timed run: the last segment's velocities reached zero over half its
+/// time.
+fn stop_at_rest<E>(
+    p: &PrevSeg,
+    opt: &VerifyOptions,
+    summary: &mut Summary,
+    emit: &mut impl FnMut(&Violation, &mut Summary) -> Result<(), E>,
+) -> Result<(), E> {
+    if p.rates.is_none() || !p.accelerations_checked {
+        return Ok(());
+    }
+    let acc = vertex_acceleration(&p.dq, p.dt, None);
+    let (o, found) = acceleration_findings(
+        opt,
+        &acc,
+        &p.end_row,
+        &format!("to rest after the segment ending at row {}", p.end_row),
+    );
+    summary.observe(&o, &p.end_row, p.lines);
+    for v in &found {
+        emit(&with_lines(v, p.lines), summary)?;
+    }
+    Ok(())
 }
 
 fn orientation_label(phi1: f64) -> i8 {
@@ -455,6 +530,7 @@ where
 {
     let mut summary = Summary::new();
     summary.timed = joints.timed();
+    let at_rest = joints.starts_at_rest();
     let mut pairer = if joints.has_id() && path.has_id() {
         Pairer::ById {
             pending: HashMap::new(),
@@ -462,8 +538,9 @@ where
             joint_lines: HashMap::new(),
         }
     } else {
-        Pairer::InOrder
+        Pairer::Undecided
     };
+    let mut last_label = String::new();
     let mut prev_row: Option<RowEval> = None;
     let mut prev_seg: Option<PrevSeg> = None;
     let mut gap = false;
@@ -523,18 +600,22 @@ where
             // In order: accelerations, flip reversals, output.
             for (k, (row, seg)) in rows.iter().zip(segs).enumerate() {
                 summary.rows += 1;
+                let lines = (row.joints_line, row.path_line);
+                last_label = row.label.clone();
                 for o in &row.obs {
-                    summary.observe(o, &row.label);
+                    summary.observe(o, &row.label, lines);
                 }
                 for v in &row.violations {
-                    emit(v, summary)?;
+                    emit(&with_lines(v, lines), summary)?;
                 }
                 let has_prev = k > 0 || prev_row.is_some();
                 let Some(mut seg) = seg else {
                     if has_prev && !row.break_before {
                         summary.segments_skipped += 1;
                     }
-                    prev_seg = None;
+                    if let Some(p) = prev_seg.take().filter(|_| at_rest) {
+                        stop_at_rest(&p, opt, summary, &mut emit)?;
+                    }
                     continue;
                 };
                 summary.segments += 1;
@@ -553,60 +634,59 @@ where
                     v.detail
                         .push_str(&format!("; reverses the flip at row {}", p.end_row));
                 }
-                if let (Some(r), Some(p)) = (seg.rates, &prev_seg)
-                    && let Some(pr) = p.rates
-                {
-                    let amax = opt.thresholds.per_joint(
-                        Th::RhoAccelMmS2,
-                        Th::Theta1AccelDegS2,
-                        Th::Theta2AccelDegS2,
-                    );
-                    let span = 0.5 * (seg.dt + p.dt);
-                    let mut worst = None;
-                    for i in 0..5 {
-                        let acc = (r[i] - pr[i]) / span;
-                        let (v, l) = if i < 3 {
-                            (acc.abs(), amax[i])
-                        } else {
-                            (acc.abs().to_degrees(), amax[i].to_degrees())
-                        };
-                        keep_worst(
-                            &mut worst,
-                            Obs::over(Check::Acceleration, v, l, JOINT_NAMES[i]),
+                // The vertex between the previous segment and this one (the block model of
+                // docs/post.md): from rest when this one starts a timed run, to rest when the
+                // previous one ended one.
+                match (
+                    seg.rates,
+                    prev_seg.as_ref().and_then(|p| p.rates.map(|r| (p, r))),
+                ) {
+                    (Some(_), Some((p, _)))
+                        if !(seg.accelerations_checked && p.accelerations_checked) => {}
+                    (Some(_), Some((p, _))) => {
+                        let acc = vertex_acceleration(&p.dq, p.dt, Some((&seg.dq, seg.dt)));
+                        let (o, found) = acceleration_findings(
+                            opt,
+                            &acc,
+                            &row.label,
+                            &format!(
+                                "between the segments ending at rows {} and {}",
+                                p.end_row, row.label
+                            ),
                         );
-                        if acc.abs() > amax[i] {
-                            let (v, l, u) = if i < 3 {
-                                (acc.abs(), amax[i], "mm/s^2")
-                            } else {
-                                (acc.abs().to_degrees(), amax[i].to_degrees(), "deg/s^2")
-                            };
-                            seg.violations.push(Violation::over(
-                                &row.label,
-                                Check::Acceleration,
-                                v,
-                                l,
-                                format!(
-                                    "{} at {v:.4} {u} between the segments ending at rows {} and {}",
-                                    JOINT_NAMES[i], p.end_row, row.label
-                                ),
-                            ));
-                        }
+                        summary.observe(&o, &row.label, lines);
+                        seg.violations.extend(found);
                     }
-                    if let Some(o) = worst {
-                        summary.observe(&o, &row.label);
+                    (Some(_), None) if at_rest && seg.accelerations_checked => {
+                        let acc = vertex_acceleration(&[0.0; 5], 0.0, Some((&seg.dq, seg.dt)));
+                        let (o, found) = acceleration_findings(
+                            opt,
+                            &acc,
+                            &row.label,
+                            &format!("from rest into the segment ending at row {}", row.label),
+                        );
+                        summary.observe(&o, &row.label, lines);
+                        seg.violations.extend(found);
                     }
+                    (None, Some((p, _))) if at_rest => {
+                        stop_at_rest(p, opt, summary, &mut emit)?;
+                    }
+                    _ => {}
                 }
                 for o in &seg.obs {
-                    summary.observe(o, &row.label);
+                    summary.observe(o, &row.label, lines);
                 }
                 for v in &seg.violations {
-                    emit(v, summary)?;
+                    emit(&with_lines(v, lines), summary)?;
                 }
                 prev_seg = Some(PrevSeg {
                     end_row: row.label.clone(),
                     rates: seg.rates,
+                    accelerations_checked: seg.accelerations_checked,
                     dt: seg.dt,
+                    dq: seg.dq,
                     flip: seg.flip,
+                    lines,
                 });
             }
             if let Some(last) = rows.into_iter().last() {
@@ -622,34 +702,117 @@ where
             Ok(())
         },
     )?;
+    // The path's end: the last timed run stops.
+    if let Some(p) = prev_seg.take().filter(|_| at_rest) {
+        stop_at_rest(
+            &p,
+            opt,
+            &mut summary,
+            &mut |v: &Violation, s: &mut Summary| {
+                s.add(v);
+                report(v)
+            },
+        )?;
+    }
     // Intended rows never matched by a joint row.
-    if let Pairer::ById {
-        pending, path_done, ..
-    } = &mut pairer
-    {
-        let mut rest: Vec<Item<PathPoint>> = pending.drain().map(|(_, v)| v).collect();
-        if !*path_done {
+    let mut rest: Vec<Item<PathPoint>> = Vec::new();
+    match &mut pairer {
+        Pairer::ById {
+            pending, path_done, ..
+        } => {
+            rest.extend(pending.drain().map(|(_, v)| v));
+            if !*path_done {
+                while let Some(item) = path.next_item()? {
+                    rest.push(item);
+                }
+            }
+            rest.sort_by_key(|i| i.index);
+        }
+        Pairer::ByTag {
+            current, covered, ..
+        } => {
+            if let Some(c) = current.take().filter(|_| !*covered) {
+                rest.push(c);
+            }
             while let Some(item) = path.next_item()? {
                 rest.push(item);
             }
         }
-        rest.sort_by_key(|i| i.index);
-        for item in rest {
-            let id = item.id.clone().unwrap_or_default();
-            let v = Violation::plain(
-                &id,
-                Check::Pairing,
-                f64::NAN,
-                format!(
-                    "id `{id}` (intended path line {}) has no joint row",
-                    item.line
-                ),
-            );
-            summary.add(&v);
-            report(&v)?;
+        Pairer::InOrder | Pairer::Undecided => {
+            while let Some(item) = path.next_item()? {
+                rest.push(item);
+            }
         }
     }
+    for item in rest {
+        let v = missing_row(&item, &last_label);
+        summary.add(&v);
+        report(&v)?;
+    }
     Ok(summary)
+}
+
+/// The finding of a path row no joint row was paired with, placed at the joint row `at`.
+fn missing_row(item: &Item<PathPoint>, at: &str) -> Violation {
+    let what = match &item.id {
+        Some(id) => format!("id `{id}` (intended path line {})", item.line),
+        None => format!("intended path row {} (line {})", item.index, item.line),
+    };
+    let mut v = Violation::plain(
+        item.id.as_deref().unwrap_or(at),
+        Check::Pairing,
+        f64::NAN,
+        format!("{what} has no joint row"),
+    );
+    v.path_line = Some(item.line);
+    v
+}
+
+/// A joint row paired with `point`, nothing passed over.
+fn paired(joints: Item<Joints>, point: Option<Item<PathPoint>>) -> Paired {
+    Paired {
+        joints,
+        point,
+        modes: None,
+        missing: Vec::new(),
+        unpaired: None,
+    }
+}
+
+/// The intended pose at `fraction` of the move from `before` to `to`, as an item of the path
+/// (at `to`'s row and line).
+fn between(
+    before: Option<&Item<PathPoint>>,
+    to: &Item<PathPoint>,
+    fraction: f64,
+) -> Result<Item<PathPoint>, String> {
+    let b = to.value.as_ref().map_err(Clone::clone)?;
+    let Some(a) = before else {
+        return Err(format!(
+            "a pose at {fraction} of the move to path row {}, the path's first row: there is no move to it",
+            to.index
+        ));
+    };
+    let a = a
+        .value
+        .as_ref()
+        .map_err(|e| format!("the move's start: {e}"))?;
+    let mv = IntendedMove::new(a.tip, a.axis, a.angles, b.tip, b.axis, b.angles)
+        .map_err(|e| e.to_string())?;
+    Ok(Item {
+        index: to.index,
+        line: to.line,
+        id: None,
+        value: Ok(PathPoint {
+            tip: mv.tip(fraction),
+            axis: mv.axis(fraction),
+            rapid: b.rapid,
+            feed: b.feed,
+            duration: None,
+            angles: mv.angles(fraction),
+        }),
+        tag: None,
+    })
 }
 
 fn next_pair<J, P, E>(
@@ -662,41 +825,94 @@ where
     P: RowSource<Row = PathPoint, Error = E>,
     E: From<PairingError>,
 {
-    match pairer {
-        Pairer::InOrder => {
-            let j = joints.next_item()?;
-            let p = path.next_item()?;
-            match (j, p) {
-                (None, None) => Ok(None),
-                (Some(j), Some(p)) => Ok(Some(Paired {
-                    joints: j,
-                    point: Some(p),
-                    modes: path.take_joint_modes(),
-                })),
-                (Some(j), None) => Err(PairingError::ExtraJointRow {
-                    joints: joints.name().to_string(),
-                    path: path.name().to_string(),
-                    line: j.line,
-                    index: j.index,
-                }
-                .into()),
-                (None, Some(p)) => Err(PairingError::ExtraPathRow {
-                    joints: joints.name().to_string(),
-                    path: path.name().to_string(),
-                    line: p.line,
-                    index: p.index,
-                }
-                .into()),
+    let Some(j) = joints.next_item()? else {
+        return Ok(None);
+    };
+    if let Pairer::Undecided = pairer {
+        *pairer = if j.tag.is_some() {
+            Pairer::ByTag {
+                current: None,
+                covered: false,
+                before: None,
             }
+        } else {
+            Pairer::InOrder
+        };
+    }
+    match pairer {
+        Pairer::Undecided | Pairer::InOrder => {
+            let p = path.next_item()?;
+            let mut pair = paired(j, p);
+            pair.modes = path.take_joint_modes();
+            if pair.point.is_none() {
+                pair.unpaired = Some(format!(
+                    "no intended row: the joint table goes on after the intended path {} ended",
+                    path.name()
+                ));
+            }
+            Ok(Some(pair))
+        }
+        Pairer::ByTag {
+            current,
+            covered,
+            before,
+        } => {
+            let Some(tag) = j.tag else {
+                let mut pair = paired(j, None);
+                pair.unpaired =
+                    Some("the block names no path row, where the program's other blocks do".into());
+                return Ok(Some(pair));
+            };
+            let mut missing = Vec::new();
+            // Read on to the row the block names; rows passed over without a block of their
+            // own are missing.
+            while current.as_ref().is_none_or(|c| c.index < tag.row) {
+                let Some(next) = path.next_item()? else {
+                    break;
+                };
+                if let Some(c) = current.take() {
+                    if !*covered {
+                        missing.push(c.clone());
+                    }
+                    *before = Some(c);
+                }
+                *current = Some(next);
+                *covered = false;
+            }
+            let mut pair = paired(j, None);
+            pair.missing = missing;
+            match current.as_ref() {
+                Some(c) if c.index == tag.row => match tag.fraction {
+                    None => {
+                        pair.point = Some(c.clone());
+                        *covered = true;
+                    }
+                    Some(f) => match between(before.as_ref(), c, f) {
+                        Ok(point) => pair.point = Some(point),
+                        Err(why) => pair.unpaired = Some(why),
+                    },
+                },
+                Some(c) if c.index > tag.row => {
+                    pair.unpaired = Some(format!(
+                        "the block names path row {}, behind the row of the block before it ({}): blocks out of order",
+                        tag.row, c.index
+                    ))
+                }
+                _ => {
+                    pair.unpaired = Some(format!(
+                        "the block names path row {}, past the end of the intended path {}",
+                        tag.row,
+                        path.name()
+                    ))
+                }
+            }
+            Ok(Some(pair))
         }
         Pairer::ById {
             pending,
             path_done,
             joint_lines,
         } => {
-            let Some(j) = joints.next_item()? else {
-                return Ok(None);
-            };
             let id = j.id.clone().unwrap_or_default();
             if let Some(&first_line) = joint_lines.get(&id) {
                 return Err(PairingError::DuplicateId {
@@ -709,11 +925,7 @@ where
             }
             joint_lines.insert(id.clone(), j.line);
             if let Some(p) = pending.remove(&id) {
-                return Ok(Some(Paired {
-                    joints: j,
-                    point: Some(p),
-                    modes: None,
-                }));
+                return Ok(Some(paired(j, Some(p))));
             }
             while !*path_done {
                 match path.next_item()? {
@@ -721,11 +933,7 @@ where
                     Some(p) => {
                         let pid = p.id.clone().unwrap_or_default();
                         if pid == id {
-                            return Ok(Some(Paired {
-                                joints: j,
-                                point: Some(p),
-                                modes: None,
-                            }));
+                            return Ok(Some(paired(j, Some(p))));
                         }
                         if let Some(old) = pending.get(&pid) {
                             return Err(PairingError::DuplicateId {
@@ -740,11 +948,7 @@ where
                     }
                 }
             }
-            Ok(Some(Paired {
-                joints: j,
-                point: None,
-                modes: None,
-            }))
+            Ok(Some(paired(j, None)))
         }
     }
 }

@@ -42,7 +42,14 @@ pub(super) fn eval_row(
         tilt_ok: false,
         singular_ok: false,
         break_before,
+        joints_line: p.joints.line,
+        path_line: p.point.as_ref().map(|i| i.line),
     };
+    // Path rows the pairing passed over without a joint row of their own.
+    for item in &p.missing {
+        e.violations
+            .push(super::missing_row(item, &label_of(&p.joints)));
+    }
     let q = match &p.joints.value {
         Ok(q) => *q,
         Err(msg) => {
@@ -55,9 +62,10 @@ pub(super) fn eval_row(
     e.q = Some(q);
     let point = match &p.point {
         None => {
-            let d = match &p.joints.id {
-                Some(id) => format!("id `{id}` is not in the intended path"),
-                None => "no intended row".into(),
+            let d = match (&p.unpaired, &p.joints.id) {
+                (Some(why), _) => why.clone(),
+                (None, Some(id)) => format!("id `{id}` is not in the intended path"),
+                (None, None) => "no intended row".into(),
             };
             e.violations
                 .push(Violation::plain(&e.label, Check::Pairing, f64::NAN, d));

@@ -4,6 +4,8 @@
 
 use super::row::{ROD_NAMES, exceeds, max_tilt, singularity_checks};
 use super::*;
+use crate::machine::intended::followed_angles;
+use crate::machine::orientation::tool_axis;
 
 /// The module pose at sliders `rho`, continued from `prev` (Newton; if it fails, the nearest
 /// assembly mode of the forward kinematics). None when the sliders cannot be assembled.
@@ -74,9 +76,19 @@ pub(super) fn eval_segment(m: &Machine, opt: &VerifyOptions, a: &RowEval, b: &Ro
         s.flip = Some(dtheta2);
         return s;
     }
+    s.dq = dq;
     // A rapid move is not interpolated along the line by the controller: no jump, chord or
-    // speed check (its speed is the machine's rapid rate, not a programmed feed).
+    // speed check (its speed is the machine's rapid rate, not a programmed feed). A rapid where
+    // the path cuts is a finding of its own.
     let rapid = pb.rapid || qb.rapid;
+    if qb.rapid && !pb.rapid {
+        s.violations.push(Violation::plain(
+            row,
+            Check::Motion,
+            f64::NAN,
+            format!("{from}: the joint program moves rapid (G0) where the intended path cuts"),
+        ));
+    }
     // 6. Joint jumps.
     let step = th.per_joint(Th::RhoStepMm, Th::Theta1StepDeg, Th::Theta2StepDeg);
     let mut jumped = false;
@@ -114,9 +126,9 @@ pub(super) fn eval_segment(m: &Machine, opt: &VerifyOptions, a: &RowEval, b: &Ro
     if !rapid {
         s.obs.extend(worst);
     }
-    if jumped {
-        return s;
-    }
+    // A jump does not end the checks: its chord, axis and limits are measured along the
+    // interpolated joints like any segment's (the size of the gouge is the finding a user
+    // needs); its speeds are the jump's own finding.
     // 6. Velocities: from the joint table's time or feed, else from the path's feed.
     let dt = match (qa.t, qb.t, qb.duration.or(pb.duration), qb.feed.or(pb.feed)) {
         (Some(ta), Some(tb), _, _) => Some(tb - ta),
@@ -134,6 +146,8 @@ pub(super) fn eval_segment(m: &Machine, opt: &VerifyOptions, a: &RowEval, b: &Ro
                 dt,
                 format!("{from}: t does not increase (dt = {dt} s)"),
             ));
+        } else if dt > 0.0 && jumped {
+            s.rates = Some(std::array::from_fn(|i| dq[i] / dt));
         } else if dt > 0.0 {
             let vmax = th.per_joint(
                 Th::RhoVelocityMmS,
@@ -167,9 +181,8 @@ pub(super) fn eval_segment(m: &Machine, opt: &VerifyOptions, a: &RowEval, b: &Ro
                 }
             }
             s.obs.extend(worst);
-            if ok {
-                s.rates = Some(rates);
-            }
+            s.accelerations_checked = ok;
+            s.rates = Some(rates);
         }
     }
     // 2, 3, 4, 5 along the interpolated joints.
@@ -211,6 +224,23 @@ fn interior(
     let mut tilts_prev = max_tilt(m, &a.module, &qa.rho).1;
     let mut around = [f64::NAN; 3];
     let mut singular: Vec<Violation> = Vec::new();
+    // The intended move (docs/verify.md): the tip along the line, the axis along the arc (or
+    // the stated angles), uniformly; the worst deviation of each, at (s, value).
+    let rapid = pb.rapid || qb.rapid;
+    // Stated angles are interpolated where the joints realize them (phi1 = alpha - theta1,
+    // phi2 = -theta2).
+    let achieved = |e: &RowEval, q: &Joints| (e.module.alpha - q.theta1, -q.theta2);
+    let (sa, sb) = (
+        followed_angles(pa.angles, achieved(a, qa)),
+        followed_angles(pb.angles, achieved(b, qb)),
+    );
+    let intended = IntendedMove::new(pa.tip, pa.axis, sa, pb.tip, pb.axis, sb).ok();
+    // The ends' own errors (their tip and axis findings), taken off along the segment: the
+    // chord is what the interpolation adds between them.
+    let ends = intended
+        .as_ref()
+        .map(|mv| end_errors(m, opt, qa, qb, a, b, mv));
+    let (mut chord_worst, mut axis_worst) = ((0.0, 0.0f64), (0.0, 0.0f64));
     for j in 1..n {
         let s = j as f64 / n as f64;
         let rho = qa.rho + drho * s;
@@ -240,27 +270,18 @@ fn interior(
             ));
             return;
         }
-        if j == half && !pb.rapid {
-            let q1 = qa.theta1 + (qb.theta1 - qa.theta1) * 0.5;
-            let q2 = qa.theta2 + (qb.theta2 - qa.theta2) * 0.5;
-            let tip = tool_pose_eq26(&m.table, &pose, q1, q2, opt.tool_length).tip;
-            let chord = (tip - (pa.tip + pb.tip) * 0.5).norm();
-            seg.obs.push(Obs::over(
-                Check::ChordError,
-                chord,
-                th.get(Th::ChordErrorMm),
-                "chordal error",
-            ));
-            if exceeds(chord, th.get(Th::ChordErrorMm)) {
-                out.push(Violation::over(
-                    row,
-                    Check::ChordError,
-                    chord,
-                    th.get(Th::ChordErrorMm),
-                    format!(
-                        "{from}: tip at the joints' midpoint is {chord:.5} mm off the intended line"
-                    ),
-                ));
+        if !rapid {
+            let q1 = qa.theta1 + (qb.theta1 - qa.theta1) * s;
+            let q2 = qa.theta2 + (qb.theta2 - qa.theta2) * s;
+            let tool = tool_pose_eq26(&m.table, &pose, q1, q2, opt.tool_length);
+            if let (Some(mv), Some(ends)) = (&intended, &ends) {
+                let (tip_dev, axis_dev) = chord_deviation(&tool, mv, ends, s);
+                if tip_dev > chord_worst.1 {
+                    chord_worst = (s, tip_dev);
+                }
+                if axis_dev > axis_worst.1 {
+                    axis_worst = (s, axis_dev);
+                }
             }
         }
         if check_tilt {
@@ -306,6 +327,48 @@ fn interior(
     }
     seg.obs.extend(singular_worst);
     seg.obs.extend(tilt_worst);
+    if !rapid && let Some(mv) = &intended {
+        let out = &mut seg.violations;
+        // The worst sample's neighbourhood, a sample either side, looked at finely: the
+        // deviation is smooth in s, and the samples are at most 2 mm of slider travel apart.
+        for (worst, is_tip) in [(chord_worst, true), (axis_worst, false)] {
+            let ends = ends.unwrap_or_default();
+            let (s0, value) =
+                refine_deviation(m, opt, qa, qb, mv, &ends, &a.module, worst, n, is_tip);
+            let (check, limit, shown, unit) = if is_tip {
+                (Check::ChordError, th.get(Th::ChordErrorMm), value, "mm")
+            } else {
+                (
+                    Check::ChordAxis,
+                    th.get(Th::ChordAxisErrorDeg),
+                    value.to_degrees(),
+                    "deg",
+                )
+            };
+            seg.obs.push(Obs::over(
+                check,
+                shown,
+                limit,
+                if is_tip {
+                    "chordal error"
+                } else {
+                    "chordal axis error"
+                },
+            ));
+            if exceeds(shown, limit) {
+                out.push(Violation::over(
+                    row,
+                    check,
+                    shown,
+                    limit,
+                    format!(
+                        "{from}: the {} of the interpolated joints is {shown:.5} {unit} off the intended move at s = {s0:.4}",
+                        if is_tip { "tip" } else { "tool axis" }
+                    ),
+                ));
+            }
+        }
+    }
     let out = &mut seg.violations;
     // The tracked mode must arrive at the end row's mode.
     let end = track(m, &pose, &qb.rho);
@@ -348,6 +411,104 @@ fn interior(
         ));
     }
     out.extend(singular);
+}
+
+/// The tip's and axis's errors at a segment's two ends (fk of the end joints against the
+/// intended poses): (tip error at s = 0, at s = 1, axis error vector at 0, at 1).
+#[derive(Debug, Clone, Copy, Default)]
+struct EndErrors {
+    tip: [Vector3<f64>; 2],
+    axis: [Vector3<f64>; 2],
+}
+
+/// The errors at the ends of a segment, in the rows' assembly modes.
+fn end_errors(
+    m: &Machine,
+    opt: &VerifyOptions,
+    qa: &Joints,
+    qb: &Joints,
+    a: &RowEval,
+    b: &RowEval,
+    mv: &IntendedMove,
+) -> EndErrors {
+    let at = |q: &Joints, pose: &ModulePose, s: f64| {
+        let tool = tool_pose_eq26(&m.table, pose, q.theta1, q.theta2, opt.tool_length);
+        (
+            tool.tip - mv.tip(s),
+            tool_axis(tool.phi1, tool.phi2) - mv.axis(s),
+        )
+    };
+    let (t0, a0) = at(qa, &a.module, 0.0);
+    let (t1, a1) = at(qb, &b.module, 1.0);
+    EndErrors {
+        tip: [t0, t1],
+        axis: [a0, a1],
+    }
+}
+
+/// The chord's deviation at s: the tool pose of the interpolated joints against the intended
+/// one, less the ends' errors interpolated (tip in mm, axis in rad).
+fn chord_deviation(
+    tool: &crate::machine::ToolPose,
+    mv: &IntendedMove,
+    ends: &EndErrors,
+    s: f64,
+) -> (f64, f64) {
+    let tip = tool.tip - mv.tip(s) - (ends.tip[0] * (1.0 - s) + ends.tip[1] * s);
+    let axis = tool_axis(tool.phi1, tool.phi2)
+        - mv.axis(s)
+        - (ends.axis[0] * (1.0 - s) + ends.axis[1] * s);
+    // |a - h| = 2 sin(angle / 2) for unit vectors.
+    (tip.norm(), 2.0 * (0.5 * axis.norm()).min(1.0).asin())
+}
+
+/// The deviation of the tip (`is_tip`) or the axis from the intended move near the worst
+/// sample `worst` = (s, value) of `n`: 16 points across the two sample intervals around it,
+/// tracked from the segment's start; the largest (s, value) found, at least the sample's.
+#[allow(clippy::too_many_arguments)]
+fn refine_deviation(
+    m: &Machine,
+    opt: &VerifyOptions,
+    qa: &Joints,
+    qb: &Joints,
+    mv: &IntendedMove,
+    ends: &EndErrors,
+    start: &ModulePose,
+    worst: (f64, f64),
+    n: usize,
+    is_tip: bool,
+) -> (f64, f64) {
+    let step = 1.0 / n as f64;
+    let (lo, hi) = ((worst.0 - step).max(0.0), (worst.0 + step).min(1.0));
+    let drho = qb.rho - qa.rho;
+    let mut best = worst;
+    let mut pose = *start;
+    // From the start to the neighbourhood, then across it, in steps of the samples' spacing.
+    let steps = ((lo / step).round() as usize).max(1);
+    for k in 1..=steps {
+        let s = lo * k as f64 / steps as f64;
+        match track(m, &pose, &(qa.rho + drho * s)) {
+            Some(p) => pose = p,
+            None => return best,
+        }
+    }
+    for k in 0..=16 {
+        let s = lo + (hi - lo) * k as f64 / 16.0;
+        let rho = qa.rho + drho * s;
+        let Some(p) = track(m, &pose, &rho) else {
+            return best;
+        };
+        pose = p;
+        let q1 = qa.theta1 + (qb.theta1 - qa.theta1) * s;
+        let q2 = qa.theta2 + (qb.theta2 - qa.theta2) * s;
+        let tool = tool_pose_eq26(&m.table, &pose, q1, q2, opt.tool_length);
+        let (tip_dev, axis_dev) = chord_deviation(&tool, mv, ends, s);
+        let value = if is_tip { tip_dev } else { axis_dev };
+        if value > best.1 {
+            best = (s, value);
+        }
+    }
+    best
 }
 
 /// The worst tilt sample, sample `j` of `n` with (tilt, rod) `worst`, refined by the parabola

@@ -32,11 +32,12 @@ pub enum Th {
     RhoAccelMmS2,
     Theta1AccelDegS2,
     Theta2AccelDegS2,
+    ChordAxisErrorDeg,
 }
 
 /// Every threshold with its default. The velocity and acceleration limits are assumptions (the
 /// VERNE's drive data are not published): set them from the machine's data sheet.
-pub const THRESHOLDS: [ThresholdSpec; 16] = [
+pub const THRESHOLDS: [ThresholdSpec; 17] = [
     ThresholdSpec {
         name: "tip_error_mm",
         default: 0.005,
@@ -133,11 +134,17 @@ pub const THRESHOLDS: [ThresholdSpec; 16] = [
         unit: "deg/s^2",
         meaning: "rotary-axis acceleration",
     },
+    ThresholdSpec {
+        name: "chord_axis_error_deg",
+        default: 0.01,
+        unit: "deg",
+        meaning: "tool axis along a block vs the intended axis there",
+    },
 ];
 
 /// The thresholds of one run, in the units of [`THRESHOLDS`].
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Thresholds([f64; 16]);
+pub struct Thresholds([f64; 17]);
 
 impl Default for Thresholds {
     fn default() -> Self {
@@ -200,10 +207,18 @@ impl Thresholds {
         Ok(())
     }
 
-    /// The defaults overridden by the machine file's `[verify]` table. Unknown names and bad
-    /// values are reported all at once, each with its line.
+    /// The defaults, the joints' speeds and accelerations from the machine file's `[drives]`
+    /// table, overridden by its `[verify]` table. Unknown names and bad values are reported all
+    /// at once, each with its line.
     pub fn from_machine(m: &Machine, source: &str) -> Result<Thresholds, MachineError> {
         let mut t = Thresholds::default();
+        let d = &m.drives;
+        t.0[Th::RhoVelocityMmS as usize] = d.velocity[0];
+        t.0[Th::Theta1VelocityDegS as usize] = d.velocity[3].to_degrees();
+        t.0[Th::Theta2VelocityDegS as usize] = d.velocity[4].to_degrees();
+        t.0[Th::RhoAccelMmS2 as usize] = d.acceleration[0];
+        t.0[Th::Theta1AccelDegS2 as usize] = d.acceleration[3].to_degrees();
+        t.0[Th::Theta2AccelDegS2 as usize] = d.acceleration[4].to_degrees();
         let mut problems = Vec::new();
         for (name, value, line) in &m.verify {
             if let Err(message) = t.set(name, *value) {
@@ -262,6 +277,6 @@ mod tests {
         assert!(t.set("theta2_flip_tol_deg", 95.0).is_err());
         t.set("lambda_min", 4.0).unwrap();
         assert!(t.check().is_err());
-        assert_eq!(THRESHOLDS.len(), Th::Theta2AccelDegS2 as usize + 1);
+        assert_eq!(THRESHOLDS.len(), Th::ChordAxisErrorDeg as usize + 1);
     }
 }

@@ -69,6 +69,7 @@ pub fn item<T>(k: usize, value: Result<T, String>) -> Item<T> {
         line: k as u64 + 2,
         id: Some((k + 1).to_string()),
         value,
+        tag: None,
     }
 }
 
