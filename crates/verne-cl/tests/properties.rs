@@ -45,7 +45,7 @@ fn corpus_inputs() -> Vec<(String, Vec<u8>)> {
         })
         .collect();
     v.sort();
-    assert_eq!(v.len(), 34);
+    assert_eq!(v.len(), 36);
     v
 }
 
