@@ -478,6 +478,12 @@ pub enum WarningKind {
     },
     /// A `$$*CATIA0` block without three lines of four numbers: its frame is not recorded.
     CatiaBlockIncomplete,
+    /// Lines after an NX listing's last line (`Tool Path Listing has N lines.`, SPEC §3.9):
+    /// this one and the rest up to a new listing header are not read.
+    AfterListingEnd {
+        /// Line of the listing's last line.
+        end_line: u64,
+    },
 }
 
 impl fmt::Display for WarningKind {
@@ -495,6 +501,10 @@ impl fmt::Display for WarningKind {
             ),
             WarningKind::CatiaBlockIncomplete => f.write_str(
                 "$$*CATIA0 block without three lines of four numbers: its frame is not recorded",
+            ),
+            WarningKind::AfterListingEnd { end_line } => write!(
+                f,
+                "after the end of the NX listing at line {end_line} (`Tool Path Listing has ... lines`): this line and the rest up to a new listing header are ignored"
             ),
         }
     }

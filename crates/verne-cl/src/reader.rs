@@ -165,7 +165,7 @@ fn decide_units<R: BufRead>(lex: &mut Lexer<R>) -> Decision {
                 }
                 continue;
             }
-            Item::Comment | Item::Text => {}
+            Item::Comment | Item::Text | Item::ListingEnd => {}
             Item::Point => first_motion = true,
             Item::Record => match classify(&lex.name) {
                 Rec::Fini => break,
@@ -532,6 +532,12 @@ impl<R: BufRead> Reader<R> {
                         ));
                     }
                 }
+                Ok(())
+            }
+            Item::ListingEnd => {
+                self.point_ok = false;
+                self.dialect(Dialect::NxListing);
+                self.summary.count_skipped(b"TOOL PATH LISTING");
                 Ok(())
             }
             Item::Comment => {

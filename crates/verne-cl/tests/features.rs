@@ -793,3 +793,58 @@ fn tlaxis_forms_that_cannot_be_read_are_refused_at_their_field() {
     assert_eq!((e.line, e.column), (2, Some(12)));
     assert!(matches!(e.kind, ClErrorKind::NumberOutOfRange { .. }));
 }
+
+// ---------------------------------------------------------------- NX listing end (SPEC §3.9)
+
+#[test]
+fn a_listing_ends_at_its_line_count_and_what_follows_is_ignored() {
+    let text = "\
+TOOL PATH/A,TOOL,T
+RAPID
+GOTO/0,0,10
+GOTO/1,0,0
+END-OF-PATH
+
+Tool Path Listing has 5 lines.
+anything # at all
+GOTO/99,99,99
+=====
+Information listing created by : x
+TOOL PATH/B,TOOL,T
+GOTO/2,0,0
+END-OF-PATH
+tool   path listing HAS 3 line
+";
+    let (rows, s) = read_opts(
+        text,
+        &Options {
+            units: Some(Units::Mm),
+            ..Options::default()
+        },
+    );
+    let tips: Vec<[f64; 3]> = rows.iter().map(|r| r.tip).collect();
+    assert_eq!(tips, [[0.0, 0.0, 10.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]]);
+    assert_eq!(s.dialect, Dialect::NxListing);
+    assert_eq!(s.skipped.get("TOOL PATH LISTING"), Some(&2));
+    let after: Vec<(u64, &WarningKind)> = s
+        .warnings
+        .iter()
+        .filter(|w| matches!(w.kind, WarningKind::AfterListingEnd { .. }))
+        .map(|w| (w.line, &w.kind))
+        .collect();
+    assert_eq!(
+        after,
+        [(8, &WarningKind::AfterListingEnd { end_line: 7 })],
+        "{:?}",
+        s.warnings
+    );
+    // Only that line: a line that merely starts like it is not the end.
+    for t in [
+        "Tool Path Listing has many lines.",
+        "Tool Path Listing has 5 lines. More",
+        "Tool Path Listing 5 lines.",
+    ] {
+        let e = err(&format!("UNITS/MM\nGOTO/0,0,0\n{t}\n"));
+        assert_eq!(e.line, 3, "{t}");
+    }
+}
