@@ -848,3 +848,29 @@ tool   path listing HAS 3 line
         assert_eq!(e.line, 3, "{t}");
     }
 }
+
+// ---------------------------------------------------------------- messages (terminal safety)
+
+#[test]
+fn messages_escape_the_control_bytes_of_the_file() {
+    let raw_control = |s: &str| s.chars().any(char::is_control);
+    for bad in [
+        &b"UNITS/MM\nGOTO/1,2,\x1b[31mX\x07\x00\n"[..],
+        b"UNITS/MM\nGOTO/0,0,0\n\x1b]0;title\x07/1,2\n",
+        b"UNITS/MM\nFEDRAT/\x1b[2J,100\nGOTO/0,0,0\n",
+        b"UNITS/MM\nGOTO/0,0,0\nTLAXIS/\x9b31m,0,1\n",
+        b"UNITS/\x00\x1b\x07\nGOTO/0,0,0\n",
+    ] {
+        let e = read_all("t.cl", bad, &Options::default()).unwrap_err();
+        let shown = e.to_string();
+        assert!(!raw_control(&shown), "{shown:?}");
+        assert!(
+            shown.contains("\\u{1b}") || shown.contains("\\u{9b}") || shown.contains("\\0"),
+            "{shown:?}"
+        );
+    }
+    // Tool names go to the summary the same way.
+    let (_, s) = read("TOOL PATH/OP,TOOL,EM\x1b[5m\nGOTO/0,0,0\n");
+    let name = s.tools[0].name.as_deref().unwrap();
+    assert!(!raw_control(name) && name.contains("\\u{1b}"), "{name:?}");
+}
