@@ -952,3 +952,28 @@ fn a_range_of_other_than_two_numbers_is_refused_at_its_line() {
     let err = GliderSpec::from_toml_str("kind = \"glider\"\nl0 = = 1\n", "s.toml").unwrap_err();
     assert_eq!(err.problems[0].line, Some(2), "{err}");
 }
+
+/// Table 1 in mm stays finite up to the largest strut length allowed, for the reason its
+/// documentation gives: in multiples of L, L0 < 2, delta-rho <= 4 and S below the square of
+/// side L0 + 2 delta-rho + 2; and it overflows beyond (the strut length the value refused).
+#[test]
+fn table_1_in_mm_is_finite_up_to_the_largest_strut_length() {
+    let rows = table1(&DesignOptions {
+        nodes: 201,
+        ..DesignOptions::default()
+    });
+    assert_eq!(rows.len(), 3);
+    let l = verne::glider::MAX_STRUT_LENGTH_MM;
+    for r in &rows {
+        assert!(r.l0 < 2.0 && r.delta_rho <= 4.0, "{}", r.mechanism);
+        assert!(
+            r.s < (r.l0 + 2.0 * r.delta_rho + 2.0).powi(2),
+            "{}",
+            r.mechanism
+        );
+        for v in [r.l0 * l, r.delta_rho * l, r.s * l * l] {
+            assert!(v.is_finite(), "{}: {v}", r.mechanism);
+        }
+        assert!((r.s * 1e200 * 1e200).is_infinite(), "{}", r.mechanism);
+    }
+}
