@@ -100,6 +100,14 @@ pub enum ClErrorKind {
         /// Record name.
         record: String,
     },
+    /// A `TLAXIS` other than `TLAXIS/i,j,k` (SPEC §5.2a): a tool axis set from surfaces or
+    /// angles, which a CL file does not carry.
+    TlaxisForm {
+        /// The field that is not a number (empty when the count is wrong).
+        found: String,
+        /// Number of fields of the record.
+        fields: usize,
+    },
     /// `UNITS` with a value other than `MM`, `INCHES`, `INCH` (SPEC §4).
     UnknownUnits {
         /// The value found.
@@ -316,6 +324,19 @@ impl fmt::Display for ClErrorKind {
                 found,
             } => write!(f, "{record} needs {expected} values, has {found}"),
             ZeroAxis { record } => write!(f, "{record} tool axis is zero"),
+            TlaxisForm { found, fields } => {
+                if found.is_empty() {
+                    write!(
+                        f,
+                        "TLAXIS needs 3 values i,j,k (a fixed tool axis), has {fields}"
+                    )
+                } else {
+                    write!(
+                        f,
+                        "TLAXIS with `{found}`: only TLAXIS/i,j,k (a fixed tool axis) can be read; its other forms set the axis from surfaces or angles, which the CL file does not carry"
+                    )
+                }
+            }
             UnknownUnits { found } => write!(
                 f,
                 "unknown UNITS value '{found}' (MM, INCHES or INCH expected)"
@@ -457,6 +478,12 @@ pub enum WarningKind {
     },
     /// A `$$*CATIA0` block without three lines of four numbers: its frame is not recorded.
     CatiaBlockIncomplete,
+    /// Lines after an NX listing's last line (`Tool Path Listing has N lines.`, SPEC §3.9):
+    /// this one and the rest up to a new listing header are not read.
+    AfterListingEnd {
+        /// Line of the listing's last line.
+        end_line: u64,
+    },
 }
 
 impl fmt::Display for WarningKind {
@@ -474,6 +501,10 @@ impl fmt::Display for WarningKind {
             ),
             WarningKind::CatiaBlockIncomplete => f.write_str(
                 "$$*CATIA0 block without three lines of four numbers: its frame is not recorded",
+            ),
+            WarningKind::AfterListingEnd { end_line } => write!(
+                f,
+                "after the end of the NX listing at line {end_line} (`Tool Path Listing has ... lines`): this line and the rest up to a new listing header are ignored"
             ),
         }
     }

@@ -171,6 +171,32 @@ fn listing_units(v: &[u8]) -> Option<Units> {
     }
 }
 
+/// The line count of an NX listing's last line, `Tool Path Listing has N lines.` (SPEC §3.9):
+/// the words case-insensitive, any run of blanks between them, `line` or `lines`, the final
+/// `.` optional. `None` for any other line.
+pub(super) fn listing_trailer(s: &[u8]) -> Option<u64> {
+    let mut words = s.split(|&b| is_blank(b)).filter(|w| !w.is_empty());
+    for w in [&b"TOOL"[..], b"PATH", b"LISTING", b"HAS"] {
+        if !words.next()?.eq_ignore_ascii_case(w) {
+            return None;
+        }
+    }
+    let n = words.next()?;
+    if n.is_empty() || !n.iter().all(u8::is_ascii_digit) {
+        return None;
+    }
+    let last = words.next()?;
+    let last = last.strip_suffix(b".").unwrap_or(last);
+    if words.next().is_some()
+        || !(last.eq_ignore_ascii_case(b"LINES") || last.eq_ignore_ascii_case(b"LINE"))
+    {
+        return None;
+    }
+    Some(n.iter().fold(0u64, |a, &d| {
+        a.saturating_mul(10).saturating_add(u64::from(d - b'0'))
+    }))
+}
+
 /// Length of the name of a free-text record at the start of `s` (SPEC §3.8): a run of letters
 /// that is one of `PARTNO`, `PPRINT`, `INSERT`, `REMARK`, `TPRINT`, not followed by a letter,
 /// digit or `_`.
@@ -238,6 +264,9 @@ fn valid_name(name: &[u8]) -> bool {
 pub(super) enum Item {
     /// A listing header line, with its units if it is `Information Units`.
     Header(Option<Units>),
+    /// The last line of an NX listing, `Tool Path Listing has N lines.`: the lines after it
+    /// are skipped up to the next listing header line (SPEC §3.9).
+    ListingEnd,
     /// A comment; its text (continuations joined with a blank) is in `content`.
     Comment,
     /// A free-text record; its name is in `name`.
@@ -279,6 +308,12 @@ pub(super) struct Lexer<R> {
     one_piece: bool,
     /// Warnings found while lexing, taken by the reader.
     pub(super) warnings: Vec<Warning>,
+    /// Line of the last NX listing's last line, while the lines after it are skipped.
+    listing_end: Option<u64>,
+    /// The lines skipped after that last line have had their warning.
+    after_end_warned: bool,
+    /// The line count that last line states.
+    pub(super) listing_lines: u64,
 }
 
 impl<R: BufRead> Lexer<R> {
@@ -300,6 +335,9 @@ impl<R: BufRead> Lexer<R> {
             first_piece_end: 0,
             one_piece: true,
             warnings: Vec::new(),
+            listing_end: None,
+            after_end_warned: false,
+            listing_lines: 0,
         }
     }
 
@@ -410,6 +448,20 @@ impl<R: BufRead> Lexer<R> {
             self.rec_line = self.line_no;
             self.rec_col = self.line_col0 + a as u64 + 1;
             let s = &self.line[a..b];
+            if let Some(end) = self.listing_end {
+                // After a listing's last line only a new listing's header is read (SPEC §3.9).
+                if header_line(s).is_none() {
+                    if !self.after_end_warned && self.warnings.len() < 16 {
+                        self.after_end_warned = true;
+                        self.warnings.push(Warning {
+                            line: self.line_no,
+                            kind: WarningKind::AfterListingEnd { end_line: end },
+                        });
+                    }
+                    continue;
+                }
+                self.listing_end = None;
+            }
             if s.starts_with(b"GOTO/") {
                 // the most frequent record: not a header, comment or free text; its name is
                 // plain (checked again by `read_record`)
@@ -434,6 +486,12 @@ impl<R: BufRead> Lexer<R> {
                     },
                 };
                 return Ok(Some(Item::Header(units)));
+            }
+            if let Some(n) = listing_trailer(s) {
+                self.listing_end = Some(self.line_no);
+                self.after_end_warned = false;
+                self.listing_lines = n;
+                return Ok(Some(Item::ListingEnd));
             }
             if s.starts_with(b"$$") {
                 self.read_comment(a, b)?;

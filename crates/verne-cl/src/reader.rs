@@ -94,6 +94,7 @@ enum Rec {
     Geometric,
     Transform,
     Paint,
+    Tlaxis,
     Other,
 }
 
@@ -120,6 +121,7 @@ fn classify(name: &[u8]) -> Rec {
         b"NURBS" | b"KNOT" | b"CNTRL" => Rec::Nurbs,
         b"TRACUT" | b"COPY" => Rec::Transform,
         b"PAINT" => Rec::Paint,
+        b"TLAXIS" => Rec::Tlaxis,
         _ if name.contains(&b',') || GEOMETRIC.contains(&name) => Rec::Geometric,
         _ => Rec::Other,
     }
@@ -163,7 +165,7 @@ fn decide_units<R: BufRead>(lex: &mut Lexer<R>) -> Decision {
                 }
                 continue;
             }
-            Item::Comment | Item::Text => {}
+            Item::Comment | Item::Text | Item::ListingEnd => {}
             Item::Point => first_motion = true,
             Item::Record => match classify(&lex.name) {
                 Rec::Fini => break,
@@ -532,6 +534,12 @@ impl<R: BufRead> Reader<R> {
                 }
                 Ok(())
             }
+            Item::ListingEnd => {
+                self.point_ok = false;
+                self.dialect(Dialect::NxListing);
+                self.summary.count_skipped(b"TOOL PATH LISTING");
+                Ok(())
+            }
             Item::Comment => {
                 self.point_ok = false;
                 self.comment()
@@ -640,6 +648,7 @@ impl<R: BufRead> Reader<R> {
                 let name = self.lex.name_str();
                 Err(self.lex.err(ClErrorKind::Transformation { name }))
             }
+            Rec::Tlaxis => self.tlaxis(),
             Rec::Paint | Rec::Other => {
                 if self.lex.name == b"UNIT" || self.lex.name.starts_with(b"CSI_SET_") {
                     self.dialect(Dialect::SolidWorks);
@@ -1186,6 +1195,46 @@ impl<R: BufRead> Reader<R> {
         self.pos = Some(p);
         self.axis = a;
         self.point_ok = m != Mot::Godlta;
+        Ok(())
+    }
+
+    /// `TLAXIS/i,j,k`: the tool axis of the following motion records that give none (3-value
+    /// `GOTO`, `FROM`, cycle points, `GODLTA/d`), in the file's frame like a `GOTO`'s axis
+    /// (SPEC §5.2a). Any other form is refused at its field.
+    fn tlaxis(&mut self) -> Result<(), ClError> {
+        let n = self.lex.nfields();
+        // A word (or an empty field) names the form; else the count is wrong at the 4th field
+        // or at the end.
+        let odd = match (0..n).find(|&i| matches!(self.lex.num(i), Num::NotNumber)) {
+            // an empty field: the lexer's message for it
+            Some(i) if self.lex.field(i).is_empty() => return self.lex.number(i).map(|_| ()),
+            Some(i) => Some((i, latin1_short(self.lex.field(i), 40))),
+            None => (n != 3).then(|| (n.min(3), String::new())),
+        };
+        if let Some((i, found)) = odd {
+            return Err(self
+                .lex
+                .err_field(i, ClErrorKind::TlaxisForm { found, fields: n }));
+        }
+        let mut raw = [0.0; 3];
+        self.lex.numbers(&mut raw)?;
+        let zero = || {
+            self.lex.err_field(
+                0,
+                ClErrorKind::ZeroAxis {
+                    record: "TLAXIS".into(),
+                },
+            )
+        };
+        if norm(raw).is_nan() || norm(raw) < 1e-9 {
+            return Err(zero());
+        }
+        // Like a motion record, the axis fixes the output frame if nothing has (SPEC §6).
+        if self.out_frame.is_none() {
+            self.out_frame = Some(self.frame);
+            self.xf = Xform::IDENTITY;
+        }
+        self.axis = unit(self.xf.vector(raw), 1e-300).ok_or_else(zero)?;
         Ok(())
     }
 

@@ -348,9 +348,19 @@ impl Summary {
     }
 }
 
-/// Latin-1 text for a message: at most `max` characters, `…` appended when cut.
+/// Latin-1 text for a message: at most `max` characters of the input, `…` appended when cut.
+/// Control characters (NUL, BEL, ESC, DEL and the C1 range 0x80-0x9F, CSI among them) are
+/// escaped as Rust writes them (`\0`, `\u{7}`, `\u{1b}`), as the core's `verne::error::shown`
+/// does: bytes of a file are never echoed raw to a terminal.
 pub(super) fn latin1_short(b: &[u8], max: usize) -> String {
-    let mut s: String = b.iter().take(max).map(|&c| c as char).collect();
+    let mut s = String::with_capacity(b.len().min(max));
+    for c in b.iter().take(max).map(|&c| c as char) {
+        if c.is_control() {
+            s.extend(c.escape_default());
+        } else {
+            s.push(c);
+        }
+    }
     if b.len() > max {
         s.push('…');
     }

@@ -713,3 +713,164 @@ fn skipped_summary_is_bounded_and_names_only() {
     assert_eq!(s.skipped.get(verne_cl::OTHER_RECORDS), Some(&145));
     assert!(s.skipped.keys().all(|k| k.len() <= 32 && !k.contains('/')));
 }
+
+// ---------------------------------------------------------------- TLAXIS (SPEC §5.2a)
+
+#[test]
+fn tlaxis_is_the_axis_of_the_motions_that_give_none() {
+    // Each expected axis is written out by hand: TLAXIS normalised, a 6-value GOTO replacing
+    // it, GODLTA/d along it, a cycle along it (R, B, Q = P + 1 a, P - 3 a, P + 1 a).
+    let (rows, _) = read(
+        "UNITS/MM\nTLAXIS/0,3,4\nFROM/0,0,100\nGOTO/10,0,0\nGOTO/10,10,0,1,0,0\nGOTO/20,10,0\n\
+         TLAXIS/0,0,-2\nGODLTA/5\nCYCLE/DRILL,FEDTO,3,RAPTO,1,MMPM,100\nGOTO/1,1,1\nCYCLE/OFF\n\
+         GOTO/2,2,2\n",
+    );
+    let tilted = [0.0, 0.6, 0.8];
+    let down = [0.0, 0.0, -1.0];
+    assert_eq!(rows.len(), 9);
+    assert_row(&rows[0], [0.0, 0.0, 100.0], tilted);
+    assert_row(&rows[1], [10.0, 0.0, 0.0], tilted);
+    assert_row(&rows[2], [10.0, 10.0, 0.0], [1.0, 0.0, 0.0]);
+    assert_row(&rows[3], [20.0, 10.0, 0.0], [1.0, 0.0, 0.0]);
+    assert_row(&rows[4], [20.0, 10.0, -5.0], down);
+    assert_row(&rows[5], [1.0, 1.0, 0.0], down);
+    assert_row(&rows[6], [1.0, 1.0, 4.0], down);
+    assert_row(&rows[7], [1.0, 1.0, 0.0], down);
+    assert_row(&rows[8], [2.0, 2.0, 2.0], down);
+    // Without TLAXIS the same 3-value GOTO has the axis (0, 0, 1): the record is what moved it.
+    let (rows, s) = read("UNITS/MM\nGOTO/10,0,0\n");
+    assert_row(&rows[0], [10.0, 0.0, 0.0], [0.0, 0.0, 1.0]);
+    assert!(!s.skipped.contains_key("TLAXIS"));
+}
+
+#[test]
+fn tlaxis_follows_the_frames() {
+    // SPEC §6.1: path B's MSYS turns its frame 90 degrees about z; the axis (1, 0, 0) written
+    // under it is (0, 1, 0) in the output frame (path A's), as a GOTO's axis would be.
+    let text = "\
+TOOL PATH/A,TOOL,T
+MSYS/0,0,0,1,0,0,0,1,0
+GOTO/0,0,0
+END-OF-PATH
+TOOL PATH/B,TOOL,T
+MSYS/100,50,20,0,1,0,-1,0,0
+TLAXIS/1,0,0
+GOTO/10,0,5
+END-OF-PATH
+";
+    let (rows, _) = read(text);
+    assert_row(&rows[1], [100.0, 60.0, 25.0], [0.0, 1.0, 0.0]);
+    // Before any frame and motion, TLAXIS fixes the output frame (as a motion would): the
+    // MSYS after it is applied to the points, and the axis is the one written.
+    let (rows, _) = read("TLAXIS/0,0,1\nMSYS/100,0,0,0,1,0,-1,0,0\nGOTO/10,0,0\n");
+    assert_row(&rows[0], [100.0, 10.0, 0.0], [0.0, 0.0, 1.0]);
+}
+
+#[test]
+fn tlaxis_forms_that_cannot_be_read_are_refused_at_their_field() {
+    for (t, column, found) in [
+        ("TLAXIS/NORMPS", 8, "NORMPS"),
+        ("TLAXIS/0,0,1,ATANGL,5", 14, "ATANGL"),
+        ("TLAXIS/0,0", 11, ""),
+        ("TLAXIS/0,0,1,0", 14, ""),
+        ("TLAXIS", 7, ""),
+    ] {
+        let e = err(&format!("UNITS/MM\nGOTO/0,0,0\n{t}\nGOTO/1,1,1\n"));
+        assert_eq!((e.line, e.column), (3, Some(column)), "{t}: {e}");
+        match &e.kind {
+            ClErrorKind::TlaxisForm { found: f, .. } => assert_eq!(f, found, "{t}"),
+            other => panic!("{t}: {other:?}"),
+        }
+        assert!(e.to_string().contains("TLAXIS"), "{e}");
+    }
+    let e = err("UNITS/MM\nTLAXIS/0,,1\nGOTO/1,1,1\n");
+    assert_eq!((e.line, e.column), (2, Some(10)));
+    assert!(matches!(e.kind, ClErrorKind::BadNumber { field: 2, .. }));
+    let e = err("UNITS/MM\nTLAXIS/0,0,0\nGOTO/1,1,1\n");
+    assert_eq!((e.line, e.column), (2, Some(8)));
+    assert!(matches!(e.kind, ClErrorKind::ZeroAxis { .. }));
+    let e = err("UNITS/MM\nTLAXIS/0,0,1e999\nGOTO/1,1,1\n");
+    assert_eq!((e.line, e.column), (2, Some(12)));
+    assert!(matches!(e.kind, ClErrorKind::NumberOutOfRange { .. }));
+}
+
+// ---------------------------------------------------------------- NX listing end (SPEC §3.9)
+
+#[test]
+fn a_listing_ends_at_its_line_count_and_what_follows_is_ignored() {
+    let text = "\
+TOOL PATH/A,TOOL,T
+RAPID
+GOTO/0,0,10
+GOTO/1,0,0
+END-OF-PATH
+
+Tool Path Listing has 5 lines.
+anything # at all
+GOTO/99,99,99
+=====
+Information listing created by : x
+TOOL PATH/B,TOOL,T
+GOTO/2,0,0
+END-OF-PATH
+tool   path listing HAS 3 line
+";
+    let (rows, s) = read_opts(
+        text,
+        &Options {
+            units: Some(Units::Mm),
+            ..Options::default()
+        },
+    );
+    let tips: Vec<[f64; 3]> = rows.iter().map(|r| r.tip).collect();
+    assert_eq!(tips, [[0.0, 0.0, 10.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]]);
+    assert_eq!(s.dialect, Dialect::NxListing);
+    assert_eq!(s.skipped.get("TOOL PATH LISTING"), Some(&2));
+    let after: Vec<(u64, &WarningKind)> = s
+        .warnings
+        .iter()
+        .filter(|w| matches!(w.kind, WarningKind::AfterListingEnd { .. }))
+        .map(|w| (w.line, &w.kind))
+        .collect();
+    assert_eq!(
+        after,
+        [(8, &WarningKind::AfterListingEnd { end_line: 7 })],
+        "{:?}",
+        s.warnings
+    );
+    // Only that line: a line that merely starts like it is not the end.
+    for t in [
+        "Tool Path Listing has many lines.",
+        "Tool Path Listing has 5 lines. More",
+        "Tool Path Listing 5 lines.",
+    ] {
+        let e = err(&format!("UNITS/MM\nGOTO/0,0,0\n{t}\n"));
+        assert_eq!(e.line, 3, "{t}");
+    }
+}
+
+// ---------------------------------------------------------------- messages (terminal safety)
+
+#[test]
+fn messages_escape_the_control_bytes_of_the_file() {
+    let raw_control = |s: &str| s.chars().any(char::is_control);
+    for bad in [
+        &b"UNITS/MM\nGOTO/1,2,\x1b[31mX\x07\x00\n"[..],
+        b"UNITS/MM\nGOTO/0,0,0\n\x1b]0;title\x07/1,2\n",
+        b"UNITS/MM\nFEDRAT/\x1b[2J,100\nGOTO/0,0,0\n",
+        b"UNITS/MM\nGOTO/0,0,0\nTLAXIS/\x9b31m,0,1\n",
+        b"UNITS/\x00\x1b\x07\nGOTO/0,0,0\n",
+    ] {
+        let e = read_all("t.cl", bad, &Options::default()).unwrap_err();
+        let shown = e.to_string();
+        assert!(!raw_control(&shown), "{shown:?}");
+        assert!(
+            shown.contains("\\u{1b}") || shown.contains("\\u{9b}") || shown.contains("\\0"),
+            "{shown:?}"
+        );
+    }
+    // Tool names go to the summary the same way.
+    let (_, s) = read("TOOL PATH/OP,TOOL,EM\x1b[5m\nGOTO/0,0,0\n");
+    let name = s.tools[0].name.as_deref().unwrap();
+    assert!(!raw_control(name) && name.contains("\\u{1b}"), "{name:?}");
+}

@@ -45,7 +45,7 @@ fn corpus_inputs() -> Vec<(String, Vec<u8>)> {
         })
         .collect();
     v.sort();
-    assert_eq!(v.len(), 34);
+    assert_eq!(v.len(), 37);
     v
 }
 
@@ -71,7 +71,8 @@ fn same_rows(a: &[Row], b: &[Row], tol: f64) -> Result<(), String> {
 }
 
 /// Whether a line may be split with `$` continuations: an ordinary record line, not a
-/// comment, free text, header, and not itself part of a continuation.
+/// comment, free text, header or a listing's last line, and not itself part of a
+/// continuation.
 fn splittable(line: &str, prev: Option<&str>) -> bool {
     let t = line.trim();
     let up = t.to_ascii_uppercase();
@@ -83,6 +84,10 @@ fn splittable(line: &str, prev: Option<&str>) -> bool {
             .any(|w| up.starts_with(w))
         && !t.contains(':')
         && !t.starts_with('=')
+        && !up
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .starts_with(&["TOOL", "PATH", "LISTING"])
         && t.len() >= 2
 }
 

@@ -185,6 +185,18 @@ pub fn parse_positive(s: &str) -> Result<f64, String> {
     }
 }
 
+/// Parses the strut length L (mm) of `verne design --l`: a finite number > 0, and at most
+/// `verne::glider::MAX_STRUT_LENGTH_MM`, beyond which Table 1 in mm (S in mm^2) overflows.
+pub fn parse_strut_length(s: &str) -> Result<f64, String> {
+    let max = verne::glider::MAX_STRUT_LENGTH_MM;
+    match parse_positive(s)? {
+        l if l <= max => Ok(l),
+        l => Err(format!(
+            "{l:e} mm is beyond {max:e} mm: S in mm^2 (S per L^2 times L^2) would overflow"
+        )),
+    }
+}
+
 /// Parses `LO,HI` with 0 < LO < HI (numbers or fractions).
 pub fn parse_lambda_bounds(s: &str) -> Result<[f64; 2], String> {
     let Some((lo, hi)) = s.split_once(',') else {
@@ -232,6 +244,18 @@ mod tests {
         assert!(parse_triple("1,2").unwrap_err().contains("three"));
         assert!(parse_triple("1,x,3").unwrap_err().contains("value 2"));
         assert!(parse_triple("1,inf,3").unwrap_err().contains("finite"));
+    }
+
+    #[test]
+    fn strut_lengths_that_overflow_table_1_are_refused() {
+        assert_eq!(parse_strut_length("1000"), Ok(1000.0));
+        assert_eq!(parse_strut_length("1e150"), Ok(1e150));
+        for bad in ["1e200", "1.0000001e150", "1e308"] {
+            let e = parse_strut_length(bad).unwrap_err();
+            assert!(e.contains("overflow"), "{bad}: {e}");
+        }
+        assert!(parse_strut_length("0").unwrap_err().contains("not > 0"));
+        assert!(parse_strut_length("inf").unwrap_err().contains("finite"));
     }
 
     #[test]

@@ -422,7 +422,7 @@ pub struct WorkspaceArgs {
 #[derive(Debug, Args)]
 pub struct DesignArgs {
     /// Strut length L in mm: Table 1 also gives L0, delta-rho (mm) and S (mm^2).
-    #[arg(long = "l", value_name = "MM", value_parser = parse_positive)]
+    #[arg(long = "l", value_name = "MM", value_parser = crate::arg_values::parse_strut_length)]
     pub l: Option<f64>,
     /// Bounds LO,HI on both velocity amplification factors, eq. (4); fractions like 1/3 allowed.
     /// The paper's values are shown only for the paper's bounds 1/3,3.

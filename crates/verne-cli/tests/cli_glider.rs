@@ -477,6 +477,15 @@ fn design_for_a_person_and_for_other_bounds() {
     // Bad bounds are a usage error.
     let bad = run(&["design", "--bounds", "3,1"], None);
     assert_eq!(bad.status.code(), Some(2));
+    // A strut length whose S in mm^2 overflows is refused, not printed as inf; the largest
+    // allowed gives finite numbers.
+    let huge = run(&["design", "--nodes", "101", "--l", "1e200"], None);
+    assert_eq!(huge.status.code(), Some(2), "{}", stderr(&huge));
+    assert!(stderr(&huge).contains("overflow"), "{}", stderr(&huge));
+    assert!(huge.stdout.is_empty());
+    let (out, rows) = design_csv(&["--l", "1e150"]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    assert!(rows.values().all(|(c, _, _)| c.is_finite()), "{rows:?}");
 }
 
 #[test]

@@ -317,10 +317,25 @@ impl<R: BufRead> Reader<R> {
                     let code = decimal_code(w)
                         .filter(|c| c % 10 == 0)
                         .ok_or_else(|| err(w, format!("M{} is not an M code", w.value)))?;
+                    let code = code / 10;
+                    if let Some((group, name)) = m_group(code) {
+                        let same = m_codes[..n_m]
+                            .iter()
+                            .flatten()
+                            .find(|(c, _)| m_group(*c).is_some_and(|(g, _)| g == group));
+                        if let Some((prev, _)) = same {
+                            return Err(err(
+                                w,
+                                format!(
+                                    "M{prev} and M{code} are in the same modal group ({name}): one per block, as LinuxCNC reads it"
+                                ),
+                            ));
+                        }
+                    }
                     if n_m == m_codes.len() {
                         return Err(err(w, "too many M codes in one block".into()));
                     }
-                    m_codes[n_m] = Some((code / 10, *w));
+                    m_codes[n_m] = Some((code, *w));
                     n_m += 1;
                 }
                 _ => {
@@ -891,6 +906,26 @@ fn show_code(code: u16) -> String {
     } else {
         format!("{}.{}", code / 10, code % 10)
     }
+}
+
+/// LinuxCNC's modal group of an M code and its name (`Interp::_ems` in interp_array.cc,
+/// LinuxCNC 2.9; the RS274/NGC groups with LinuxCNC's additions): 4 stopping, 5 input and
+/// output, 6 tool change, 7 spindle (with M19 and the modal state codes M70-M73), 8 coolant,
+/// 9 override switches, 10 user-defined M100-M199. `None` for the codes in no group (M98/M99,
+/// read as o-words, and the codes LinuxCNC does not know). Two codes of one group in a block
+/// are an error in LinuxCNC (`read_m`): M7 and M8 too, although both coolants may be on at
+/// once (checked with its `rs274`).
+fn m_group(code: u16) -> Option<(u8, &'static str)> {
+    Some(match code {
+        0 | 1 | 2 | 30 | 60 => (4, "stopping"),
+        62..=68 => (5, "input and output"),
+        6 | 61 => (6, "tool change"),
+        3 | 4 | 5 | 19 | 70..=73 => (7, "spindle"),
+        7..=9 => (8, "coolant"),
+        48..=53 => (9, "override switches"),
+        100..=199 => (10, "user-defined"),
+        _ => return None,
+    })
 }
 
 /// The modal group of a G code that verne reads (applies or refuses by name); `None` for

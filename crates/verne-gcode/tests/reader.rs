@@ -267,3 +267,40 @@ fn sniffing_tells_gcode_from_csv_and_cl() {
     assert!(has_gcode_extension("part.NGC") && has_gcode_extension("a.b.tap"));
     assert!(!has_gcode_extension("part.cl") && !has_gcode_extension("ngc"));
 }
+
+/// Two M codes of one of LinuxCNC's modal groups in a block are refused at the second, with the
+/// line and column (`Interp::read_m`); codes of different groups are read. The groups are
+/// LinuxCNC's own table (`Interp::_ems`), and `rs274.rs` checks the same blocks against its
+/// interpreter.
+#[test]
+fn two_m_codes_of_one_modal_group_are_refused() {
+    for (block, second, group) in [
+        ("M3 M5", "M5", "spindle"),
+        ("M4 M19", "M19", "spindle"),
+        ("M70 M3", "M3", "spindle"),
+        ("M3 M3", "M3", "spindle"),
+        ("M2 M30", "M30", "stopping"),
+        ("M0 M1", "M1", "stopping"),
+        ("M0 M60", "M60", "stopping"),
+        ("M7 M9", "M9", "coolant"),
+        ("M7 M8", "M8", "coolant"),
+        ("M8 M7 M9", "M7", "coolant"),
+        ("M48 M49", "M49", "override"),
+        ("M6 M61", "M61", "tool change"),
+        ("M100 M101", "M101", "user-defined"),
+    ] {
+        let program = format!("G21 G90\nG0 X0 Y0 Z10\nF100 {block} G1 X1\nM2\n");
+        let e = refuse(&program);
+        let column = program.lines().nth(2).unwrap().rfind(second).unwrap() as u64 + 1;
+        assert_eq!((e.line, e.column), (3, Some(column)), "{block}: {e}");
+        assert!(
+            e.message.contains("same modal group") && e.message.contains(group),
+            "{block}: {e}"
+        );
+    }
+    for block in ["M3 M8", "M5 M9", "M3 M6 M8 M48", "M1 M5"] {
+        let (rows, s) = read(&format!("G21 G90\nT1 {block} G0 X1 Y2 Z3\nM2\n"));
+        assert_eq!(rows.len(), 1, "{block}");
+        assert!(s.end_line.is_some(), "{block}");
+    }
+}

@@ -288,3 +288,59 @@ fn what_the_reader_refuses_it_refuses_at_the_line() {
         assert!(e.message.contains(what), "{file}: {e}");
     }
 }
+
+/// Blocks with two M codes: the reader refuses those LinuxCNC's interpreter refuses as two M
+/// codes of one modal group, and reads the others.
+#[test]
+fn m_codes_of_one_modal_group_are_refused_as_linuxcnc_refuses_them() {
+    let Some(rs274) = rs274() else { return };
+    let dir = std::env::temp_dir().join(format!("verne-m-groups-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut both = [0; 2];
+    for block in [
+        "M3 M5",
+        "M4 M19",
+        "M70 M3",
+        "M3 M3",
+        "M2 M30",
+        "M0 M1",
+        "M0 M60",
+        "M1 M2",
+        "M7 M9",
+        "M7 M8",
+        "M8 M9",
+        "M48 M49",
+        "M50 P1 M51 P1",
+        "M6 M61",
+        "M100 M101",
+        "M3 M8",
+        "M5 M9",
+        "M3 M6 M8 M48",
+        "M1 M5",
+        "M5 M30",
+        "M7 M49",
+        "M62 P1 M3",
+    ] {
+        let program = format!("G21 G90\nT1 F100 G0 X0 Y0 Z10\n{block} G1 X1\nM2\n");
+        let path = dir.join("m.ngc");
+        std::fs::write(&path, &program).unwrap();
+        let out = Command::new(&rs274).arg("-g").arg(&path).output().unwrap();
+        let text = String::from_utf8_lossy(&out.stdout).to_string()
+            + &String::from_utf8_lossy(&out.stderr);
+        let linuxcnc_refuses = text.contains("Two m codes used from same modal group");
+        let ours = read_all(program.as_bytes(), &Options::default());
+        let we_refuse = ours
+            .as_ref()
+            .is_err_and(|e| e.message.contains("same modal group"));
+        assert_eq!(
+            we_refuse, linuxcnc_refuses,
+            "{block}: LinuxCNC says {text:?}, the reader {ours:?}"
+        );
+        if !we_refuse {
+            assert!(ours.is_ok(), "{block}: {ours:?}");
+        }
+        both[usize::from(we_refuse)] += 1;
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(both[0] >= 5 && both[1] >= 10, "{both:?}");
+}

@@ -39,3 +39,11 @@ pub const CONFIG_SIGN_MM: f64 = 1e-9;
 /// Joint limits are checked with this slack (mm for sliders, rad for angles) so that a value
 /// computed exactly at a limit is inside it.
 pub const LIMIT_SLACK: f64 = 1e-9;
+
+/// A platform point is proved beyond the rods' reach from the strokes only when it lies outside
+/// the reach box by more than this (mm), plus [`REACH_MARGIN_REL`] of the magnitudes involved:
+/// far more than the rounding of the box and of the point, and than [`LIMIT_SLACK`].
+pub const REACH_MARGIN_MM: f64 = 1e-6;
+
+/// See [`REACH_MARGIN_MM`] (dimensionless).
+pub const REACH_MARGIN_REL: f64 = 1e-12;

@@ -905,4 +905,75 @@ rho2_range = [0.0, 0.5]
     assert!(
         err.problems[0].message.contains("speed") || err.problems[0].message.contains("missing")
     );
+    // Every problem carries the line of its key: the lines of `bad` counted by hand.
+    let lines: Vec<Option<usize>> = GliderSpec::from_toml_str(bad, "bad.toml")
+        .unwrap_err()
+        .problems
+        .iter()
+        .map(|p| p.line)
+        .collect();
+    assert_eq!(lines, [Some(2), Some(3), Some(6), Some(8), Some(9)]);
+    assert!(msg.contains("bad.toml:9: rho1_range"), "{msg}");
+}
+
+/// A range is two numbers, [min, max]: a list of any other length is refused with the line of
+/// its key (three numbers were read as the first two).
+#[test]
+fn a_range_of_other_than_two_numbers_is_refused_at_its_line() {
+    let good = GliderSpec::preset("biglide1").unwrap().to_toml_string();
+    for (key, list, count) in [
+        ("rho1_range", "[0.0, 0.3, 0.5]", 3),
+        ("rho2_range", "[0.0, 0.1, 0.2, 0.5]", 4),
+        ("rho1_range", "[0.5]", 1),
+        ("rho2_range", "[]", 0),
+    ] {
+        let text: String = good
+            .lines()
+            .map(|l| {
+                if l.starts_with(key) {
+                    format!("{key} = {list}\n")
+                } else {
+                    format!("{l}\n")
+                }
+            })
+            .collect();
+        let line = text.lines().position(|l| l.starts_with(key)).unwrap() + 1;
+        let err = GliderSpec::from_toml_str(&text, "g.toml").unwrap_err();
+        assert_eq!(err.problems.len(), 1, "{key} = {list}: {err}");
+        let p = &err.problems[0];
+        assert_eq!((p.key.as_str(), p.line), (key, Some(line)), "{err}");
+        assert!(p.message.contains(&format!("has {count} number")), "{err}");
+        assert!(
+            err.to_string().contains(&format!("g.toml:{line}: {key}")),
+            "{err}"
+        );
+    }
+    // A syntax error has its line too.
+    let err = GliderSpec::from_toml_str("kind = \"glider\"\nl0 = = 1\n", "s.toml").unwrap_err();
+    assert_eq!(err.problems[0].line, Some(2), "{err}");
+}
+
+/// Table 1 in mm stays finite up to the largest strut length allowed, for the reason its
+/// documentation gives: in multiples of L, L0 < 2, delta-rho <= 4 and S below the square of
+/// side L0 + 2 delta-rho + 2; and it overflows beyond (the strut length the value refused).
+#[test]
+fn table_1_in_mm_is_finite_up_to_the_largest_strut_length() {
+    let rows = table1(&DesignOptions {
+        nodes: 201,
+        ..DesignOptions::default()
+    });
+    assert_eq!(rows.len(), 3);
+    let l = verne::glider::MAX_STRUT_LENGTH_MM;
+    for r in &rows {
+        assert!(r.l0 < 2.0 && r.delta_rho <= 4.0, "{}", r.mechanism);
+        assert!(
+            r.s < (r.l0 + 2.0 * r.delta_rho + 2.0).powi(2),
+            "{}",
+            r.mechanism
+        );
+        for v in [r.l0 * l, r.delta_rho * l, r.s * l * l] {
+            assert!(v.is_finite(), "{}: {v}", r.mechanism);
+        }
+        assert!((r.s * 1e200 * 1e200).is_infinite(), "{}", r.mechanism);
+    }
 }

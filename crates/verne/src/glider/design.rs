@@ -24,6 +24,13 @@ const DELTA_RHO_SCAN_STEPS_PER_L: usize = 1000;
 /// Largest joint range searched, in multiples of L.
 const DELTA_RHO_SCAN_MAX_L: f64 = 4.0;
 
+/// Largest strut length L (mm) whose Table 1 in mm (L0 L, delta-rho L, S L^2) is finite. In
+/// multiples of L, L0 < 2 and delta-rho <= 4 (the ranges the design scans); the
+/// workspace lies within L of the guides' strokes, so its rectangle S is within a square of
+/// side L0 + 2 delta-rho + 2 < 12: S < 144 L^2, and at L = 1e150 mm, S < 1.44e302 mm^2, below
+/// f64::MAX (1.8e308). Beyond it S in mm^2 can overflow (L = 1e200 mm gives infinity).
+pub const MAX_STRUT_LENGTH_MM: f64 = 1e150;
+
 /// Samples per joint of the joint box when its envelope is measured.
 const ENVELOPE_JOINT_SAMPLES: usize = 401;
 

@@ -11,8 +11,9 @@ pub mod verdict;
 pub mod workspace;
 
 pub use design::{
-    Architecture, DesignOptions, Dimensions, PaperTable1, PaperTable2, Table1Row, Table2Row,
-    Target, architecture_spec, design_spec, dimension, envelope, table1, table1_row, table2,
+    Architecture, DesignOptions, Dimensions, MAX_STRUT_LENGTH_MM, PaperTable1, PaperTable2,
+    Table1Row, Table2Row, Target, architecture_spec, design_spec, dimension, envelope, table1,
+    table1_row, table2,
 };
 pub use jacobian::{
     Amplification, Jacobians, amplification, det_a, det_b, is_parallel_singular,

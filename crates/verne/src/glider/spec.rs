@@ -41,13 +41,18 @@ struct SpecFile {
     l1: f64,
     l2: f64,
     l0: f64,
-    rho1_range: [f64; 2],
-    rho2_range: [f64; 2],
+    /// `[min, max]`; read as a list so that a list of another length is refused by name and
+    /// line (a fixed-size array would take the first two numbers of three).
+    rho1_range: Vec<f64>,
+    rho2_range: Vec<f64>,
 }
 
 /// One problem found in a glider description, naming its key.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SpecProblem {
+    /// 1-based line in the text, when the description came from a text and the problem is on
+    /// one of its lines.
+    pub line: Option<usize>,
     /// The TOML key concerned (`l0`, `rho1_range`), empty for a syntax error.
     pub key: String,
     pub message: String,
@@ -72,10 +77,14 @@ impl fmt::Display for GliderSpecError {
             if n == 1 { "" } else { "s" }
         )?;
         for p in &self.problems {
+            write!(f, "\n  {}", self.source)?;
+            if let Some(line) = p.line {
+                write!(f, ":{line}")?;
+            }
             if p.key.is_empty() {
-                write!(f, "\n  {}: {}", self.source, p.message)?;
+                write!(f, ": {}", p.message)?;
             } else {
-                write!(f, "\n  {}: {}: {}", self.source, p.key, p.message)?;
+                write!(f, ": {}: {}", p.key, p.message)?;
             }
         }
         Ok(())
@@ -83,6 +92,28 @@ impl fmt::Display for GliderSpecError {
 }
 
 impl std::error::Error for GliderSpecError {}
+
+/// The 1-based line of byte offset `at` of `text`.
+fn line_at(text: &str, at: usize) -> usize {
+    text.as_bytes()[..at.min(text.len())]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count()
+        + 1
+}
+
+/// The 1-based line of the first `key = ...` of a glider file (a flat TOML table).
+fn key_line(text: &str, key: &str) -> Option<usize> {
+    if key.is_empty() {
+        return None;
+    }
+    text.lines()
+        .position(|l| {
+            l.split_once('=')
+                .is_some_and(|(lhs, _)| lhs.trim().trim_matches('"') == key)
+        })
+        .map(|i| i + 1)
+}
 
 /// Names of the presets of section 3.1, Wenger 2001, in the paper's order.
 pub const PRESET_NAMES: [&str; 3] = ["biglide1", "biglide2", "orthoglide"];
@@ -117,6 +148,7 @@ impl GliderSpec {
         };
         let file: SpecFile = toml::from_str(text).map_err(|e| {
             error(vec![SpecProblem {
+                line: e.span().map(|r| line_at(text, r.start)),
                 key: String::new(),
                 message: e.to_string().trim_end().replace('\n', "\n    "),
             }])
@@ -124,10 +156,30 @@ impl GliderSpec {
         let mut problems = Vec::new();
         if file.kind != "glider" {
             problems.push(SpecProblem {
+                line: None,
                 key: "kind".into(),
                 message: format!("is {:?}, expected \"glider\"", file.kind),
             });
         }
+        let mut range = |key: &str, v: &[f64]| match *v {
+            [lo, hi] => [lo, hi],
+            _ => {
+                problems.push(SpecProblem {
+                    line: None,
+                    key: key.into(),
+                    message: format!(
+                        "has {} number{}, expected two: [min, max]",
+                        v.len(),
+                        if v.len() == 1 { "" } else { "s" }
+                    ),
+                });
+                [0.0, 0.0]
+            }
+        };
+        let (rho1_range, rho2_range) = (
+            range("rho1_range", &file.rho1_range),
+            range("rho2_range", &file.rho2_range),
+        );
         let spec = GliderSpec {
             name: file.name,
             alpha1: file.alpha1_deg.to_radians(),
@@ -135,10 +187,13 @@ impl GliderSpec {
             l1: file.l1,
             l2: file.l2,
             l0: file.l0,
-            rho1_range: file.rho1_range,
-            rho2_range: file.rho2_range,
+            rho1_range,
+            rho2_range,
         };
         problems.extend(spec.validate());
+        for p in &mut problems {
+            p.line = p.line.or_else(|| key_line(text, &p.key));
+        }
         if problems.is_empty() {
             Ok(spec)
         } else {
@@ -156,8 +211,8 @@ impl GliderSpec {
             l1: self.l1,
             l2: self.l2,
             l0: self.l0,
-            rho1_range: self.rho1_range,
-            rho2_range: self.rho2_range,
+            rho1_range: self.rho1_range.to_vec(),
+            rho2_range: self.rho2_range.to_vec(),
         };
         toml::to_string(&file).expect("a flat struct of numbers and strings serialises")
     }
@@ -167,6 +222,7 @@ impl GliderSpec {
         let mut problems = Vec::new();
         let mut push = |key: &str, message: String| {
             problems.push(SpecProblem {
+                line: None,
                 key: key.into(),
                 message,
             })

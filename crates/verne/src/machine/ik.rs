@@ -33,6 +33,7 @@ use crate::parallel_module::branches::{
 use crate::parallel_module::equations::{ModulePose, Sliders, residual_mm_sc};
 use crate::parallel_module::ik::{Leg1, distinct_branches, posture_branches, wrap_angle};
 use crate::parallel_module::leg1_certify;
+use crate::parallel_module::reach::ReachBox;
 use crate::spec::{Machine, TableGeometry};
 use crate::tolerance::{
     ACCEPT_RESIDUAL_MM, NEWTON_MAX_ITER, NEWTON_STEP_STOP, SAME_SOLUTION_MM, SAME_SOLUTION_RAD,
@@ -91,7 +92,11 @@ const ROOT_POLISH_RAD: f64 = 1e-6;
 
 /// The platform point in the frame that follows the tilting axis, w = trans(z, d_t) rot(x, pi)
 /// rot(z, -phi2) (U + Delta a): constant in theta1 (eqs. (7)-(9), AIM 2007).
-fn tilt_frame_platform(table: &TableGeometry, pose: &ToolPose, tool_length: f64) -> Vector3<f64> {
+pub(crate) fn tilt_frame_platform(
+    table: &TableGeometry,
+    pose: &ToolPose,
+    tool_length: f64,
+) -> Vector3<f64> {
     let (s2, c2) = pose.phi2.sin_cos();
     let (s1, c1) = pose.phi1.sin_cos();
     let u = pose.tip;
@@ -350,9 +355,15 @@ pub fn machine_ik_into(
     let g = &m.module;
     let (r, rr) = (g.r_big1, g.r_small1);
     let (sin_phi1, cos_phi1) = pose.phi1.sin_cos();
+    let w = tilt_frame_platform(&m.table, pose, tool_length);
+    // Every platform point of the pose beyond the rods' reach from the strokes: no branch
+    // within them, proved before F's coefficients lose their digits to the pose's size.
+    if ReachBox::of(m).circle_beyond(w.x, m.table.d_a, w.y, w.z) {
+        return;
+    }
     let path = Leg1Path {
         m,
-        w: tilt_frame_platform(&m.table, pose, tool_length),
+        w,
         sin_phi1,
         cos_phi1,
     };

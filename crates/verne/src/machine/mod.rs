@@ -27,6 +27,8 @@ pub mod path;
 pub mod transforms;
 
 pub use fk::{MAX_MACHINE_FK_MODES, MachineFkMode, MachineFkModes, machine_fk};
+#[cfg(test)]
+pub(crate) use ik::tilt_frame_platform;
 pub use ik::{
     ALPHA_ZERO_SEED_REL, BOTH_SIGNS_SIN_ALPHA, MAX_MACHINE_IK_BRANCHES, MAX_THETA1_SOLUTIONS,
     MachineIkBranch, MachineIkBranches, machine_ik, machine_ik_into, theta1_equation,

@@ -1,8 +1,10 @@
 //! Leg I's two postures as the two factors of the inverse kinematics' eliminated equation: the
 //! proof of completeness where double precision alone cannot give it ([`crate::math::certify`]), for
 //! the machine's theta1 equation (15) along a tool pose (AIM 2007;
-//! [`crate::machine::theta1_equation`]) and for the module's equation in alpha at a fixed
-//! point (IFToMM 2007 eq. (7), whose cubic in cos(alpha) is eq. (9)).
+//! [`crate::machine::theta1_equation`]), for the module's equation in alpha at a fixed
+//! point (IFToMM 2007 eq. (7), whose cubic in cos(alpha) is eq. (9)), and for eq. (15) along
+//! the platform points P(alpha) of a workspace's tool tip (AIM 2007 eqs. (26)-(27);
+//! [`crate::workspace::classify`]).
 //!
 //! Along a tool pose, P(theta1) = (w_x, c w_y - s w_z, d_a + s w_y + c w_z) and alpha = theta1 +
 //! phi1 (AIM 2007 eqs. (7)-(9), (14)); at a fixed point, P is constant and the angle is alpha.
@@ -72,14 +74,27 @@ pub(crate) fn path_forms<T: Scalar>(
 
 /// The forms at a fixed point P (the module's inverse kinematics): the angle is alpha itself.
 pub(crate) fn point_forms<T: Scalar>(g: &ModuleGeometry, p: &Vector3<f64>) -> PathForms<T> {
+    alpha_forms(g, p.x, [p.y, 0.0, 0.0], [p.z, 0.0, 0.0])
+}
+
+/// The forms along P(alpha) = (x, yp(alpha), zp(alpha)), the angle alpha itself, with
+/// yp = yp[0] + yp[1] cos(alpha) + yp[2] sin(alpha) and zp likewise, taken as exact: the
+/// platform points of a tool tip (eq. (27), AIM 2007) or of a point of the manufacturing
+/// workspace (eq. (26)).
+pub(crate) fn alpha_forms<T: Scalar>(
+    g: &ModuleGeometry,
+    x: f64,
+    yp: [f64; 3],
+    zp: [f64; 3],
+) -> PathForms<T> {
     let t = |x: f64| T::from(x);
     let (r, rr) = (t(g.r_big1), t(g.r_small1));
     let (zero, one) = (t(0.0), t(1.0));
-    let u = t(p.x) + t(g.dx1);
+    let u = t(x) + t(g.dx1);
     let rr2 = t(2.0) * r * rr;
     PathForms {
-        yp: Lin::new(t(p.y), zero, zero),
-        zp: Lin::new(t(p.z), zero, zero),
+        yp: Lin::new(t(yp[0]), t(yp[1]), t(yp[2])),
+        zp: Lin::new(t(zp[0]), t(zp[1]), t(zp[2])),
         sa: Lin::new(zero, zero, one),
         wf: Lin::new(-rr, r, zero),
         k1: Lin::new(t(g.l1) * t(g.l1) - r * r - rr * rr, rr2, zero),
@@ -127,9 +142,14 @@ const EQUATION_OPS: f64 = 64.0;
 /// coefficients: the magnitude of its formula ([`Mag`]) times the rounding of
 /// [`EQUATION_OPS`] operations.
 pub(crate) fn equation_error(m: &Machine, w: &Vector3<f64>, sp: f64, cp: f64) -> f64 {
-    let f = path_forms::<Mag>(m, w, sp, cp);
+    forms_error(&m.module, &path_forms::<Mag>(m, w, sp, cp))
+}
+
+/// [`equation_error`] for any forms: F computed from them as `theta1_equation` computes it
+/// (R1^2 sa^2 (u^2 - K1) + yp^2 (R1^2 + r1^2 - 2 R1 r1 cos alpha)).
+pub(crate) fn forms_error(g: &ModuleGeometry, f: &PathForms<Mag>) -> f64 {
     let n1 = |l: &Lin<Mag>| l.c0.0 + l.cc.0 + l.cs.0;
-    let (r, rr) = (m.module.r_big1, m.module.r_small1);
+    let (r, rr) = (g.r_big1, g.r_small1);
     // |cos a| and |sin a| share the bound |sp| + |cp|.
     let trig = n1(&f.sa);
     let u2_k1 = f.u2.0 + n1(&f.k1);
@@ -240,28 +260,51 @@ pub(crate) fn resolve(
     allowed: &mut ArrayVec<Proved, 12>,
     fallback: &mut ArrayVec<Proved, 12>,
 ) -> Resolution {
-    let fi = path_forms::<Iv>(m, w, sp, cp);
-    let ff = path_forms::<f64>(m, w, sp, cp);
     if !equation_error(m, w, sp, cp).is_finite() {
         return Resolution::Unproved;
     }
+    let forms = AllForms {
+        iv: path_forms(m, w, sp, cp),
+        f64: path_forms(m, w, sp, cp),
+        tracked: path_forms(m, w, sp, cp),
+    };
+    resolve_forms(&forms, ambiguous, proved, allowed, fallback)
+}
+
+/// The forms of one equation in the three arithmetics [`resolve_forms`] needs.
+pub(crate) struct AllForms {
+    pub iv: PathForms<Iv>,
+    pub f64: PathForms<f64>,
+    pub tracked: PathForms<Tracked>,
+}
+
+/// [`resolve`] for any forms (their error bound checked finite by the caller).
+#[cold]
+#[inline(never)]
+pub(crate) fn resolve_forms(
+    forms: &AllForms,
+    ambiguous: &[[f64; 2]],
+    proved: &mut ArrayVec<Proved, 12>,
+    allowed: &mut ArrayVec<Proved, 12>,
+    fallback: &mut ArrayVec<Proved, 12>,
+) -> Resolution {
+    let (fi, ff, tf) = (&forms.iv, &forms.f64, &forms.tracked);
     let factors = [1.0, -1.0].map(|sigma| Posture {
-        iv: &fi,
-        f64: &ff,
+        iv: fi,
+        f64: ff,
         sigma,
     });
     let mut worst = Resolution::Factored;
     for [lo, hi] in certify::pieces(ambiguous) {
         if let Ok(roots) = certify::all_factor_roots(&factors, lo, hi) {
             for (k, x) in roots {
-                let _ = proved.try_push((x, factor_rho1(&ff, x, factors[k].sigma)));
+                let _ = proved.try_push((x, factor_rho1(ff, x, factors[k].sigma)));
             }
             continue;
         }
-        let tf = path_forms::<Tracked>(m, w, sp, cp);
-        let found = certify::dd_roots(|at_pi| half_angle_poly(&tf, at_pi), lo, hi);
+        let found = certify::dd_roots(|at_pi| half_angle_poly(tf, at_pi), lo, hi);
         let push = |to: &mut ArrayVec<Proved, 12>, x: f64| {
-            if let Some(rho1) = posture_rho1(&ff, x) {
+            if let Some(rho1) = posture_rho1(ff, x) {
                 let _ = to.try_push((x, rho1));
             }
         };
@@ -271,14 +314,14 @@ pub(crate) fn resolve(
                 roots.iter().for_each(|&x| push(proved, x));
                 // At most one posture per sign of rho1 - zp in each: both tried.
                 for (_, middle) in undecided {
-                    both_signs(&ff, middle, allowed);
+                    both_signs(ff, middle, allowed);
                 }
             }
             DdVerdict::Unproved { roots, middles } => {
                 worst = Resolution::Unproved;
                 roots.iter().for_each(|&x| push(fallback, x));
                 for x in middles {
-                    both_signs(&ff, x, fallback);
+                    both_signs(ff, x, fallback);
                 }
             }
         }

@@ -9,6 +9,8 @@
 //! - [`fk`]: forward kinematics, every real assembly mode of three slider positions (section VI);
 //! - [`track`]: the working assembly mode along a path, following the previous row;
 //! - [`kinetostatics`]: the Jacobians A and B, singularities and amplification factors;
+//! - [`reach`]: the box the platform reaches with every slider within its stroke, checked before
+//!   solving;
 //! - [`fk_certify`], `leg1_certify`: the proofs of completeness where double precision cannot
 //!   decide.
 
@@ -20,5 +22,6 @@ pub mod fk_certify;
 pub mod ik;
 pub mod kinetostatics;
 pub(crate) mod leg1_certify;
+pub mod reach;
 #[doc(hidden)]
 pub mod track;

@@ -33,6 +33,8 @@ enum Check {
     Positive,
     /// Any finite number (mm).
     Finite,
+    /// A length that must be >= 0 (mm).
+    NonNegative,
     /// An angle in degrees within (0, 90].
     TiltDegrees,
     /// An angle in degrees within [-180, 180].
@@ -158,7 +160,12 @@ const SCHEMA: &[(&str, &str, Check, &str)] = &[
         Check::Finite,
         "table: tilting axis to table top along z (mm)",
     ),
-    ("tool", "length", Check::Finite, "tool length Delta (mm)"),
+    (
+        "tool",
+        "length",
+        Check::NonNegative,
+        "tool length Delta (mm)",
+    ),
 ];
 
 const TOP_LEVEL_KEYS: &[&str] = &["kind", "name", "base"];
@@ -737,6 +744,7 @@ fn finish(
         let bad = match check {
             _ if !x.is_finite() => Some("must be a finite number"),
             Check::Positive if x <= 0.0 => Some("must be a positive length"),
+            Check::NonNegative if x < 0.0 => Some("must be a length >= 0"),
             Check::TiltDegrees if !(x > 0.0 && x <= 90.0) => Some("must be in (0, 90] degrees"),
             Check::AngleDegrees if !(-180.0..=180.0).contains(&x) => {
                 Some("must be in [-180, 180] degrees")
@@ -920,6 +928,35 @@ mod tests {
         let expected_line = text.lines().position(|l| l.starts_with("R1 =")).unwrap() + 1;
         assert_eq!(r1.line, Some(expected_line));
         assert!(err.to_string().contains("bad.toml:"));
+    }
+
+    /// The tool tip is at distance Delta >= 0 from P along the platform's z axis (eq. (27),
+    /// AIM 2007): a negative length is refused at its line, zero is read.
+    #[test]
+    fn a_negative_tool_length_is_refused_at_its_line() {
+        for bad in ["-5.0", "-1e-9", "-0.5e3"] {
+            let text = DEFAULT_MACHINE_TOML.replace("length = 50.0", &format!("length = {bad}"));
+            let err = Machine::from_toml_str(&text, "t.toml").unwrap_err();
+            let line = text
+                .lines()
+                .position(|l| l.starts_with("length ="))
+                .unwrap()
+                + 1;
+            assert_eq!(err.problems.len(), 1, "{err}");
+            let p = &err.problems[0];
+            assert_eq!(
+                (p.key.as_str(), p.line),
+                ("tool.length", Some(line)),
+                "{err}"
+            );
+            assert!(
+                err.to_string()
+                    .contains(&format!("t.toml:{line}: tool.length")),
+                "{err}"
+            );
+        }
+        let text = DEFAULT_MACHINE_TOML.replace("length = 50.0", "length = 0.0");
+        assert_eq!(Machine::from_toml_str(&text, "t").unwrap().tool_length, 0.0);
     }
 
     #[test]

@@ -4,11 +4,15 @@
 
 use nalgebra::Vector3;
 
+use arrayvec::ArrayVec;
+
+use crate::math::scalar::{Mag, Scalar};
 use crate::math::trig::{MAX_TRIG_ROOTS, Trig};
 use crate::parallel_module::branches::{Reason, WORKING_CONFIG};
 use crate::parallel_module::equations::ModulePose;
 use crate::parallel_module::ik::{self, IkBranch, wrap_angle};
 use crate::parallel_module::kinetostatics::amplification_factors;
+use crate::parallel_module::leg1_certify::{self, AllForms, PathForms};
 use crate::spec::{Machine, ModuleGeometry, TableGeometry};
 use crate::tolerance::LIMIT_SLACK;
 
@@ -108,28 +112,79 @@ impl PlatformOfAlpha {
     /// Eq. (15), AIM 2007, at P(alpha): a trigonometric polynomial of degree 3 in alpha (the
     /// paper's degree-6 polynomial in tan(alpha/2)),
     ///
-    /// G = R1^2 sin^2(alpha) (u^2 - L1^2 + K) + K yp^2, K = R1^2 + r1^2 - 2 R1 r1 cos(alpha),
-    /// u = xp + D1 - d1, yp = a0 + a_s sin(alpha) + a_c cos(alpha).
+    /// G = R1^2 sin^2(alpha) (u^2 - K1) + yp^2 N, K1 = L1^2 - N, N = R1^2 + r1^2 - 2 R1 r1 cos(alpha),
+    /// u = xp + D1 - d1, yp = a0 + a_s sin(alpha) + a_c cos(alpha),
+    ///
+    /// computed as the machine's `theta1_equation` computes it, so that the bound of
+    /// [`leg1_certify::forms_error`] holds for it.
     fn coupling_equation(&self, g: &ModuleGeometry) -> Trig {
-        let (r, rr, l) = (g.r_big1, g.r_small1, g.l1);
+        let (r, rr) = (g.r_big1, g.r_small1);
         let u = self.x + g.dx1;
-        let k = Trig::linear(r * r + rr * rr, -2.0 * r * rr, 0.0);
+        let k0 = g.l1 * g.l1 - r * r - rr * rr;
+        let ca = Trig::linear(0.0, 1.0, 0.0);
+        let sa = Trig::linear(0.0, 0.0, 1.0);
         let yp = Trig::linear(self.a[0], self.a[2], self.a[1]);
-        let sin = Trig::linear(0.0, 0.0, 1.0);
-        sin.mul_deg::<1, 1>(&sin)
-            .mul_deg::<2, 1>(&k.add(&Trig::linear(u * u - l * l, 0.0, 0.0)))
+        let u2_k1 = Trig::linear(u * u - k0, 0.0, 0.0).add(&ca.scale(-2.0 * r * rr));
+        let n1 = Trig::linear(r * r + rr * rr, 0.0, 0.0).add(&ca.scale(-2.0 * r * rr));
+        sa.mul_deg::<1, 1>(&sa)
+            .mul_deg::<2, 1>(&u2_k1)
             .scale(r * r)
-            .add(&k.mul_deg::<1, 2>(&yp.mul_deg::<1, 1>(&yp)))
+            .add(&yp.mul_deg::<1, 1>(&yp).mul_deg::<2, 1>(&n1))
+    }
+
+    /// The leg-I forms of P(alpha) ([`leg1_certify::alpha_forms`]) in any arithmetic.
+    fn forms<T: Scalar>(&self, g: &ModuleGeometry) -> PathForms<T> {
+        leg1_certify::alpha_forms(
+            g,
+            self.x,
+            [self.a[0], self.a[2], self.a[1]],
+            [self.b[0], self.b[2], self.b[1]],
+        )
     }
 }
 
-/// Every real alpha in (-pi, pi] with G(alpha) = 0, sorted: isolated on the circle by
-/// [`Trig::roots`] (complete by construction; a double root or a pair too close to separate is
-/// one candidate, which the inverse kinematics at P(alpha) then decides).
-fn coupling_roots(g: &Trig) -> arrayvec::ArrayVec<f64, MAX_TRIG_ROOTS> {
-    let mut out: arrayvec::ArrayVec<f64, MAX_TRIG_ROOTS> =
-        g.roots().into_iter().map(wrap_angle).collect();
-    out.sort_by(f64::total_cmp);
+/// Most candidate angles of one grid point: the roots isolated on the circle and the postures
+/// of the intervals the isolation left undecided (proved, allowed, best effort).
+const MAX_CANDIDATES: usize = MAX_TRIG_ROOTS + 36;
+
+/// Every real alpha with G(alpha) = 0 for the exact G, as candidates for the inverse
+/// kinematics at P(alpha) to decide. The simple roots are isolated on the circle with G's
+/// rounding accounted for ([`Trig::roots_certified`] with the bound of
+/// [`leg1_certify::forms_error`]). Where G comes within its rounding of zero, the isolation
+/// cannot tell a double root from a close pair or from none: that happens on the symmetry
+/// plane y = 0, where yp(alpha) = w sin(alpha) and G = sin^2(alpha) (...) has double roots at
+/// alpha = 0 and pi, which the rounding of G's coefficients turns into no root or into two.
+/// G = h+ h- is the product of leg I's two unsquared equations, one per sign of rho1 - zp, and
+/// each has a simple root there: those intervals are decided on the factors
+/// ([`leg1_certify::resolve_forms`]), or by double-double, with best-effort candidates where
+/// nothing is proved.
+fn coupling_candidates(g: &ModuleGeometry, map: &PlatformOfAlpha) -> ArrayVec<f64, MAX_CANDIDATES> {
+    let mut out: ArrayVec<f64, MAX_CANDIDATES> = ArrayVec::new();
+    let err = leg1_certify::forms_error(g, &map.forms::<Mag>(g));
+    if !err.is_finite() {
+        return out;
+    }
+    let iso = map.coupling_equation(g).roots_certified(err);
+    out.extend(iso.roots.iter().map(|r| wrap_angle(r.x)));
+    if !iso.ambiguous.is_empty() {
+        let forms = AllForms {
+            iv: map.forms(g),
+            f64: map.forms(g),
+            tracked: map.forms(g),
+        };
+        let (mut proved, mut allowed, mut fallback) =
+            (ArrayVec::new(), ArrayVec::new(), ArrayVec::new());
+        leg1_certify::resolve_forms(
+            &forms,
+            &iso.ambiguous,
+            &mut proved,
+            &mut allowed,
+            &mut fallback,
+        );
+        for (alpha, _) in proved.iter().chain(&allowed).chain(&fallback) {
+            let _ = out.try_push(wrap_angle(*alpha));
+        }
+    }
     out
 }
 
@@ -214,8 +269,7 @@ pub fn classify(m: &Machine, opts: &WorkspaceOptions, q: &Vector3<f64>) -> Point
         }
         Of::Tool | Of::Manufacturing => {
             let map = PlatformOfAlpha::new(opts.of, &m.table, opts.tool_length, q);
-            let coupling = map.coupling_equation(&m.module);
-            for alpha in coupling_roots(&coupling) {
+            for alpha in coupling_candidates(&m.module, &map) {
                 let p = map.at(alpha);
                 for b in ik::solve(m, &p) {
                     if wrap_angle(b.alpha - alpha).abs() < ALPHA_MATCH_RAD {
@@ -275,6 +329,50 @@ mod tests {
                 assert!((back - p).amax() < 1e-9, "{of:?}: {back} vs {p}");
             }
         }
+    }
+
+    /// The bound the isolation is given covers the rounding of G's coefficients: G as
+    /// [`PlatformOfAlpha::coupling_equation`] computes it against eq. (15) evaluated in
+    /// double-double from the same inputs, at 64 angles, for tool tips and manufacturing points
+    /// near and far, on and off the plane y = 0, with tool lengths that are not round.
+    #[test]
+    fn the_coupling_error_bound_covers_its_rounding() {
+        use crate::math::dd::Tracked;
+        let m = Machine::default_verne();
+        let g = m.module;
+        let mut unit = crate::math::test_rng::lcg(0xc0_9e15);
+        let mut worst = 0.0f64;
+        for k in 0..400 {
+            let span = [600.0, 1500.0, 1e4][k % 3];
+            let y = if k % 4 == 0 {
+                0.0
+            } else {
+                (unit() - 0.5) * span
+            };
+            let q = Vector3::new((unit() - 0.5) * span, y, unit() * span);
+            let delta = unit() * 200.0;
+            let of = [Of::Tool, Of::Manufacturing][k % 2];
+            let map = PlatformOfAlpha::new(of, &m.table, delta, &q);
+            let coupling = map.coupling_equation(&g);
+            let bound = leg1_certify::forms_error(&g, &map.forms::<Mag>(&g));
+            let t = Tracked::exact;
+            let (r, rr, l) = (t(g.r_big1), t(g.r_small1), t(g.l1));
+            let u = t(map.x) + t(g.dx1);
+            for i in 0..64 {
+                let (s, c) = (PI * (f64::from(i) / 32.0 - 1.0) + 0.01).sin_cos();
+                let (ts, tc) = (t(s), t(c));
+                let yp = t(map.a[0]) + t(map.a[1]) * ts + t(map.a[2]) * tc;
+                let n = r * r + rr * rr - t(2.0) * r * rr * tc;
+                let exact = r * r * ts * ts * (u * u - (l * l - n)) + yp * yp * n;
+                let diff = (coupling.eval_sc(s, c) - exact.v.to_f64()).abs();
+                assert!(
+                    diff <= bound,
+                    "{of:?} {q:?} Delta {delta}: {diff:e} > {bound:e}"
+                );
+                worst = worst.max(diff / bound);
+            }
+        }
+        assert!(worst > 0.0, "no rounding seen at all");
     }
 
     #[test]
