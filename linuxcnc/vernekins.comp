@@ -7,8 +7,9 @@ World: X Y Z = tool tip in the workpiece frame (mm); A = phi1, C = phi2, the too
 angles of AIM 2007 eq. (8) (degrees). Joints: 0..2 = sliders rho1..rho3 (mm), 3 = theta1
 (tilting axis, degrees), 4 = theta2 (rotary axis, degrees).
 
-The inverse keeps the branch of the incoming joints and unwraps theta2 next to them; the
-forward follows the previous assembly mode (certified tracking, the complete solution when
+The inverse keeps the branch of the incoming joints (proved from them alone where it can be,
+by the complete solve otherwise) and unwraps theta2 next to them; the forward follows the
+previous assembly mode (certified tracking, the complete solution when
 tracking cannot prove its step). A pose that cannot be reached on the same branch, inside the
 limits and away from singularities makes the call fail: motion stops with a kinematics error,
 never a jump. See docs/linuxcnc.md.
@@ -39,6 +40,7 @@ static struct vk_haldata {
     hal_u32_t   *inverse_calls;
     hal_u32_t   *forward_calls;
     hal_u32_t   *ik_branches;
+    hal_u32_t   *ik_fallbacks;
     hal_u32_t   *fk_modes;
     hal_float_t *tool_length;
 } *vk;
@@ -57,12 +59,13 @@ EXTRA_SETUP() {
     res += hal_pin_u32_newf(HAL_OUT, &vk->inverse_calls, comp_id, "vernekins.inverse-calls");
     res += hal_pin_u32_newf(HAL_OUT, &vk->forward_calls, comp_id, "vernekins.forward-calls");
     res += hal_pin_u32_newf(HAL_OUT, &vk->ik_branches, comp_id, "vernekins.ik-branches");
+    res += hal_pin_u32_newf(HAL_OUT, &vk->ik_fallbacks, comp_id, "vernekins.ik-fallbacks");
     res += hal_pin_u32_newf(HAL_OUT, &vk->fk_modes, comp_id, "vernekins.fk-modes");
     res += hal_pin_float_newf(HAL_IN, &vk->tool_length, comp_id, "vernekins.tool-length");
     if (res) return -1;
     *vk->fail_count = 0; *vk->last_status = 0;
     *vk->inverse_calls = 0; *vk->forward_calls = 0;
-    *vk->ik_branches = 0; *vk->fk_modes = 0;
+    *vk->ik_branches = 0; *vk->ik_fallbacks = 0; *vk->fk_modes = 0;
     /* Start-up, not the servo thread: reading the machine file and allocating are fine. */
     err[0] = 0;
     kins = verne_kins_new(machine, err, sizeof(err));
@@ -114,9 +117,12 @@ int kinematicsInverse(const EmcPose *pos, double *j,
     double jj[5] = { j[0], j[1], j[2], j[3], j[4] };   /* the previous joints: the branch */
     VerneKinsInfo info = { 0, 0 };
     int n;
+    VerneKinsStatus r;
     (*vk->inverse_calls)++;
     if (vk_tool()) return vk_record(VERNE_KINS_STATUS_BAD_ARGUMENTS);
-    if (vk_record(verne_kins_inverse(kins, w, jj, 0u, &info))) return -1;
+    r = verne_kins_inverse(kins, w, jj, 0u, &info);
+    *vk->ik_fallbacks = (hal_u32_t)verne_kins_inverse_fallbacks(kins);
+    if (vk_record(r)) return -1;
     *vk->ik_branches = info.branches;
     for (n = 0; n < 5; n++) j[n] = jj[n];
     return 0;

@@ -129,7 +129,7 @@ try:
     pins = {}
     for p in ["vernekins.fail-count", "vernekins.last-status", "vernekins.inverse-calls",
               "vernekins.forward-calls", "vernekins.tool-length", "vernekins.ik-branches",
-              "vernekins.fk-modes",
+              "vernekins.ik-fallbacks", "vernekins.fk-modes",
               "sampler.0.overruns", "sampler.0.sample-num", "motion.program-line",
               "motion.motion-enabled"] + ["joint.%d.pos-cmd" % j for j in range(5)]:
         pins[p] = getp(p)

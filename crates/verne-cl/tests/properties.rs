@@ -1,6 +1,6 @@
 //! Property-style checks: the same program written differently gives the same rows
 //! (random `$` continuation splits, inch vs mm, case/blanks/CRLF), very long lines and records
-//! are read (their time is measured by `examples/throughput.rs`, not here), and a random-bytes /
+//! are read (their time is measured by `examples/cl_throughput.rs`, not here), and a random-bytes /
 //! mutation loop over [`fuzz_read`] never panics.
 
 use std::fs;

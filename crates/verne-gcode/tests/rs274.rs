@@ -15,6 +15,16 @@ fn corpus() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/gcode")
 }
 
+/// The tests that run `rs274` take turns: the interpreter keeps its parameters in a file of the
+/// working directory (`rs274ngc.var`), which two runs at once would share.
+static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+/// Holds the turn of a test that runs `rs274` (a test that failed while holding it does not
+/// stop the others).
+fn turn() -> std::sync::MutexGuard<'static, ()> {
+    ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner())
+}
+
 fn rs274() -> Option<PathBuf> {
     let found = ["/usr/bin/rs274", "/usr/local/bin/rs274"]
         .iter()
@@ -146,6 +156,7 @@ const PRINTED: f64 = 1.5e-3;
 
 #[test]
 fn the_reader_makes_linuxcnc_s_canonical_moves() {
+    let _turn = turn();
     let Some(rs274) = rs274() else { return };
     let mut checked = 0;
     let mut entries: Vec<PathBuf> = std::fs::read_dir(corpus())
@@ -293,6 +304,7 @@ fn what_the_reader_refuses_it_refuses_at_the_line() {
 /// codes of one modal group, and reads the others.
 #[test]
 fn m_codes_of_one_modal_group_are_refused_as_linuxcnc_refuses_them() {
+    let _turn = turn();
     let Some(rs274) = rs274() else { return };
     let dir = std::env::temp_dir().join(format!("verne-m-groups-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();

@@ -17,6 +17,14 @@
 #define VERNE_KINS_RADIANS 1
 
 /*
+ Inverse: solve every branch of the pose and choose the continuation among them, on every
+ call (flags bit), instead of proving the continuation from the previous joints first; and
+ decide the singularity thresholds by singular value decompositions alone. The same answers,
+ slower: for comparisons.
+ */
+#define VERNE_KINS_COMPLETE 2
+
+/*
  What a call returns.
  */
 typedef enum VerneKinsStatus {
@@ -68,7 +76,8 @@ typedef struct VerneKins VerneKins;
  */
 typedef struct VerneKinsInfo {
   /*
-   Real inverse-kinematics branches of the pose (inverse), every solution of both.
+   Inverse: 1 when the branch of the previous joints was continued (proved from them
+   alone), else the number of real branches of the complete solve.
    */
   uint32_t branches;
   /*
@@ -123,8 +132,11 @@ double verne_kins_tool_length(const struct VerneKins *k);
 /*
  Inverse kinematics: `world` = (X, Y, Z, phi1, phi2) to `joints_in_out` = (rho1, rho2, rho3,
  theta1, theta2), which holds the previous joints on entry: the branch that continues them is
- kept, and theta2 is unwrapped next to them. `info` (may be null) receives the number of real
- branches.
+ kept, and theta2 is unwrapped next to them. The branch is proved to be the continuation from
+ the previous joints alone where it can be (a step of a servo period), else chosen among every
+ branch of the pose (the complete solve, counted by [`verne_kins_inverse_fallbacks`]): the same
+ branch either way. `info` (may be null) receives the number of branches the answer was
+ chosen from (1 when continued).
 
  # Safety
  `k` is null or a valid handle; `world` is null or points to 5 doubles; `joints_in_out` is
@@ -149,6 +161,16 @@ enum VerneKinsStatus verne_kins_forward(struct VerneKins *k,
                                         double *world_in_out,
                                         uint32_t flags,
                                         struct VerneKinsInfo *info);
+
+/*
+ Inverse calls so far whose continuation could not be proved from the previous joints alone
+ (the first call of a move from afar, a jump of the pose, a singularity or another branch
+ nearby, a limit), answered by the complete solve; 0 for a null handle.
+
+ # Safety
+ `k` is null or a valid handle.
+ */
+uint64_t verne_kins_inverse_fallbacks(const struct VerneKins *k);
 
 /*
  A short English description of a status (a static string; "unknown status" for other

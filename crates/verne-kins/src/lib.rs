@@ -7,31 +7,40 @@
 //! and the rotary axis theta2 (degrees, or radians). See docs/linuxcnc.md.
 //!
 //! Every call takes the previous solution in its `*_in_out` array: the inverse keeps the branch
-//! of the previous joints and unwraps theta2 next to them; the forward returns the machine's
-//! assembly mode and unwraps phi2 next to the previous world angle. Nothing is allocated per
-//! call, no function panics across the boundary (each body runs under `catch_unwind`, and a
-//! panic is reported as [`VerneKinsStatus::Internal`]), and on any status but
-//! [`VerneKinsStatus::Ok`] the output array is left as it came.
+//! of the previous joints (proved from them alone where it can be, by the complete solve
+//! otherwise: `verne::machine::continuation`) and unwraps theta2 next to them; the forward
+//! returns the machine's assembly mode and unwraps phi2 next to the previous world angle.
+//! Nothing is allocated per call, no function panics across the boundary (each body runs under
+//! `catch_unwind`, and a panic is reported as [`VerneKinsStatus::Internal`]), and on any status
+//! but [`VerneKinsStatus::Ok`] the output array is left as it came.
 
 #![deny(missing_docs)]
 
 use std::ffi::{CStr, c_char};
 use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use nalgebra::Vector3;
 use verne::machine::{
-    JOINT_DISTANCE_MM_PER_RAD, MachineIkBranch, ToolPose, machine_ik, tool_pose_eq26,
+    MachineIkBranch, MachineIkBranches, NoBranch, PreviousJoints, ToolPose, choose_continuation,
+    continue_branch, machine_ik_into, tool_pose_eq26,
 };
 use verne::parallel_module::equations::ModulePose;
 use verne::parallel_module::fk::{self as module_fk, FkModes};
 use verne::parallel_module::ik::wrap_angle;
-use verne::parallel_module::kinetostatics::kinetostatics;
+use verne::parallel_module::kinetostatics::{SingularityLimits, kinetostatics};
 use verne::parallel_module::track::FkTracker;
 use verne::spec::Machine;
 use verne::verify::{Th, Thresholds};
 
 /// Angles in radians instead of degrees (flags bit).
 pub const VERNE_KINS_RADIANS: u32 = 1;
+
+/// Inverse: solve every branch of the pose and choose the continuation among them, on every
+/// call (flags bit), instead of proving the continuation from the previous joints first; and
+/// decide the singularity thresholds by singular value decompositions alone. The same answers,
+/// slower: for comparisons.
+pub const VERNE_KINS_COMPLETE: u32 = 2;
 
 /// What a call returns.
 #[repr(C)]
@@ -62,7 +71,8 @@ pub enum VerneKinsStatus {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct VerneKinsInfo {
-    /// Real inverse-kinematics branches of the pose (inverse), every solution of both.
+    /// Inverse: 1 when the branch of the previous joints was continued (proved from them
+    /// alone), else the number of real branches of the complete solve.
     pub branches: u32,
     /// Forward: 1 when the previous call's mode was followed (certified tracking), else the
     /// number of real assembly modes of the complete solution.
@@ -85,14 +95,9 @@ pub struct VerneKins {
     singularity: SingularityLimits,
     /// The forward's output list, kept to allocate nothing per call.
     modes: FkModes,
-}
-
-/// Where a pose counts as next to a singularity: the thresholds `verne verify` uses.
-#[derive(Debug, Clone, Copy)]
-struct SingularityLimits {
-    lambda_min: f64,
-    lambda_max: f64,
-    parallel_margin_min: f64,
+    /// Inverse calls the continuation could not prove, answered by the complete solve
+    /// ([`verne_kins_inverse_fallbacks`]). Atomic: the inverse takes a shared handle.
+    fallbacks: AtomicU64,
 }
 
 impl VerneKins {
@@ -113,6 +118,7 @@ impl VerneKins {
             machine,
             singularity,
             modes: FkModes::default(),
+            fallbacks: AtomicU64::new(0),
         })
     }
 }
@@ -230,8 +236,11 @@ pub unsafe extern "C" fn verne_kins_tool_length(k: *const VerneKins) -> f64 {
 
 /// Inverse kinematics: `world` = (X, Y, Z, phi1, phi2) to `joints_in_out` = (rho1, rho2, rho3,
 /// theta1, theta2), which holds the previous joints on entry: the branch that continues them is
-/// kept, and theta2 is unwrapped next to them. `info` (may be null) receives the number of real
-/// branches.
+/// kept, and theta2 is unwrapped next to them. The branch is proved to be the continuation from
+/// the previous joints alone where it can be (a step of a servo period), else chosen among every
+/// branch of the pose (the complete solve, counted by [`verne_kins_inverse_fallbacks`]): the same
+/// branch either way. `info` (may be null) receives the number of branches the answer was
+/// chosen from (1 when continued).
 ///
 /// # Safety
 /// `k` is null or a valid handle; `world` is null or points to 5 doubles; `joints_in_out` is
@@ -310,6 +319,18 @@ pub unsafe extern "C" fn verne_kins_forward(
     })
 }
 
+/// Inverse calls so far whose continuation could not be proved from the previous joints alone
+/// (the first call of a move from afar, a jump of the pose, a singularity or another branch
+/// nearby, a limit), answered by the complete solve; 0 for a null handle.
+///
+/// # Safety
+/// `k` is null or a valid handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn verne_kins_inverse_fallbacks(k: *const VerneKins) -> u64 {
+    // SAFETY: null or valid (the caller's contract).
+    unsafe { k.as_ref() }.map_or(0, |k| k.fallbacks.load(Ordering::Relaxed))
+}
+
 /// A short English description of a status (a static string; "unknown status" for other
 /// values).
 #[unsafe(no_mangle)]
@@ -337,17 +358,6 @@ fn to_rad(flags: u32) -> f64 {
     }
 }
 
-/// The machine's kind of branch: every slider attachment above its platform attachment and the
-/// rods of leg I not crossing (the only verdict failures left are limits).
-fn machine_kind(b: &MachineIkBranch) -> bool {
-    b.working() || b.verdict.only_limits()
-}
-
-/// Joint-space distance, slider travel and table rotation on one scale.
-fn distance(b: &MachineIkBranch, rho: &Vector3<f64>, theta1: f64) -> f64 {
-    (b.rho - rho).amax() + JOINT_DISTANCE_MM_PER_RAD * wrap_angle(b.theta1 - theta1).abs()
-}
-
 fn inverse(
     k: &VerneKins,
     w: &[f64; 5],
@@ -364,32 +374,35 @@ fn inverse(
         phi1: w[3] * a,
         phi2: w[4] * a,
     };
-    let prev_rho = Vector3::new(j[0], j[1], j[2]);
-    let (prev_theta1, prev_theta2) = (j[3] * a, j[4] * a);
-    let branches = machine_ik(&k.machine, &pose, k.tool_length);
-    info.branches = branches.len() as u32;
-    if !branches.certificate.proved() {
-        return VerneKinsStatus::Uncertified;
-    }
-    if branches.is_empty() {
-        return VerneKinsStatus::Unreachable;
-    }
-    // The continuation: the branch of the machine's kind nearest the previous joints.
-    let nearest = |ok: &dyn Fn(&MachineIkBranch) -> bool| {
-        branches
-            .iter()
-            .filter(|b| ok(b))
-            .min_by(|x, y| {
-                distance(x, &prev_rho, prev_theta1).total_cmp(&distance(y, &prev_rho, prev_theta1))
-            })
-            .copied()
+    let prev = PreviousJoints {
+        rho: Vector3::new(j[0], j[1], j[2]),
+        theta1: j[3] * a,
     };
-    let chosen = match nearest(&machine_kind) {
-        Some(b) if b.working() => b,
-        Some(_) if nearest(&|b| b.working()).is_some() => return VerneKinsStatus::BranchLost,
-        _ => return VerneKinsStatus::Limits,
+    let prev_theta2 = j[4] * a;
+    let mut branches = MachineIkBranches::new();
+    let complete = flags & VERNE_KINS_COMPLETE != 0;
+    // The continuation of the previous joints' branch: proved from them alone, or chosen from
+    // every branch of the pose (the complete solve) when that proof fails or is not wanted.
+    let answer = if complete {
+        machine_ik_into(&k.machine, &pose, k.tool_length, &mut branches);
+        info.branches = branches.len() as u32;
+        choose_continuation(&branches, &prev)
+    } else {
+        let c = continue_branch(&k.machine, &pose, k.tool_length, &prev, &mut branches);
+        if c.fallback.is_some() {
+            k.fallbacks.fetch_add(1, Ordering::Relaxed);
+        }
+        info.branches = c.branches as u32;
+        c.answer
     };
-    if near_singularity(k, &chosen) {
+    let chosen = match answer {
+        Ok(b) => b,
+        Err(NoBranch::Uncertified) => return VerneKinsStatus::Uncertified,
+        Err(NoBranch::Unreachable) => return VerneKinsStatus::Unreachable,
+        Err(NoBranch::BranchLost) => return VerneKinsStatus::BranchLost,
+        Err(NoBranch::Limits) => return VerneKinsStatus::Limits,
+    };
+    if near_singularity(k, &chosen, complete) {
         return VerneKinsStatus::NearSingularity;
     }
     let theta2 = prev_theta2 + wrap_angle(chosen.theta2 - prev_theta2);
@@ -405,18 +418,19 @@ fn inverse(
 
 /// The branch's module pose is next to a singularity by the thresholds of `verne verify`:
 /// an amplification factor outside [lambda_min, lambda_max] or a parallel margin below its
-/// minimum (IFToMM 2007 section VII; docs/verify.md).
-fn near_singularity(k: &VerneKins, b: &MachineIkBranch) -> bool {
+/// minimum (IFToMM 2007 section VII; docs/verify.md). Proved clear without singular value
+/// decompositions where it can be, unless `complete`; the same verdict either way.
+fn near_singularity(k: &VerneKins, b: &MachineIkBranch, complete: bool) -> bool {
     let pose = ModulePose {
         p: b.platform,
         alpha: b.alpha,
     };
-    let ks = kinetostatics(&k.machine.module, &pose, &b.rho);
-    let l = &k.singularity;
-    // Written so that a NaN counts as singular.
-    !(ks.amplification[0] <= l.lambda_max
-        && ks.amplification[2] >= l.lambda_min
-        && ks.parallel_margin >= l.parallel_margin_min)
+    let (g, l) = (&k.machine.module, &k.singularity);
+    if complete {
+        !l.admit(&kinetostatics(g, &pose, &b.rho))
+    } else {
+        !l.admit_pose(g, &pose, &b.rho)
+    }
 }
 
 fn forward(

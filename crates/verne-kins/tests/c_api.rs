@@ -28,6 +28,47 @@ fn round_trip_keeps_the_pose() {
     unsafe { verne_kins_free(k) };
 }
 
+/// A step of a servo period is continued from the previous joints (`info.branches` is 1, no
+/// fallback counted); with `VERNE_KINS_COMPLETE` every branch is solved (the pose's 16) and the
+/// same joints come back; a call the continuation cannot prove (an unreachable pose) is
+/// answered by the complete solve and counted; a null handle counts nothing.
+#[test]
+fn the_continuation_and_its_fallbacks_are_counted() {
+    let k = handle();
+    let inverse = |world: &[f64; 5], joints: &mut [f64; 5], flags: u32| {
+        let mut info = VerneKinsInfo::default();
+        let s =
+            unsafe { verne_kins_inverse(k, world.as_ptr(), joints.as_mut_ptr(), flags, &mut info) };
+        (s, info.branches)
+    };
+    let world = [10.0, -20.0, 5.0, 12.0, 30.0];
+    let mut start = [300.0, 250.0, 250.0, 0.0, 0.0];
+    assert_eq!(
+        inverse(&world, &mut start, VERNE_KINS_COMPLETE),
+        (VerneKinsStatus::Ok, 16)
+    );
+    assert_eq!(unsafe { verne_kins_inverse_fallbacks(k) }, 0);
+    let next = [10.1, -20.0, 5.0, 12.05, 30.1];
+    let (mut cont, mut full) = (start, start);
+    assert_eq!(inverse(&next, &mut cont, 0), (VerneKinsStatus::Ok, 1));
+    assert_eq!(
+        inverse(&next, &mut full, VERNE_KINS_COMPLETE),
+        (VerneKinsStatus::Ok, 16)
+    );
+    for d in 0..5 {
+        assert!((cont[d] - full[d]).abs() <= 1e-12, "{cont:?} vs {full:?}");
+    }
+    assert_eq!(unsafe { verne_kins_inverse_fallbacks(k) }, 0);
+    let far = [5000.0, 0.0, 0.0, 0.0, 0.0];
+    assert_eq!(
+        inverse(&far, &mut cont, 0),
+        (VerneKinsStatus::Unreachable, 0)
+    );
+    assert_eq!(unsafe { verne_kins_inverse_fallbacks(k) }, 1);
+    assert_eq!(unsafe { verne_kins_inverse_fallbacks(std::ptr::null()) }, 0);
+    unsafe { verne_kins_free(k) };
+}
+
 #[test]
 fn bad_arguments_are_refused_without_writing() {
     let k = handle();

@@ -717,3 +717,41 @@ fn non_finite_joints_give_no_mode() {
         );
     }
 }
+
+mod continuation_walk;
+
+/// The continuation answers as the complete solve's choice does (the branch, its joints within
+/// `SAME_JOINTS`, the verdicts of the limits and of the singularity thresholds), fallbacks
+/// included, on random walks: 200,000 poses at a servo period's steps in the workspace, 20,000
+/// at steps a hundred times larger, and 50,000 at a servo period's steps across the
+/// workspace's boundary (unreachable poses, limits); and it answers almost every servo step in
+/// the workspace alone. The walks of a million poses: `examples/continuation_walk.rs`
+/// (docs/benchmarks.md).
+#[test]
+fn the_continuation_is_the_complete_solve_s_choice_on_random_walks() {
+    use continuation_walk::{ACROSS, SERVO_STEP, WORKSPACE, walk};
+    let m = Machine::default_verne();
+    for (n, region, step, seed) in [
+        (200_000, WORKSPACE, SERVO_STEP, 0x3a1c_0000_0000_0001),
+        (
+            20_000,
+            WORKSPACE,
+            SERVO_STEP.times(100.0),
+            0x3a1c_0000_0000_0002,
+        ),
+        (50_000, ACROSS, SERVO_STEP, 0x3a1c_0000_0000_0003),
+    ] {
+        let w = walk(&m, n, region, step, seed);
+        println!("{region:?} {step:?}: {w:?}");
+        assert_eq!(w.different, 0, "{:#?}", w.differences);
+        assert!(w.continued + w.fallbacks.iter().sum::<u64>() == n);
+        if region.tilt_deg == WORKSPACE.tilt_deg && step.tip_mm == SERVO_STEP.tip_mm {
+            // Nearly every servo step in the workspace is proved alone.
+            assert!(w.continued as f64 >= 0.99 * n as f64, "{w:?}");
+        }
+        if region.tilt_deg == ACROSS.tilt_deg {
+            // The walk does leave the workspace.
+            assert!(w.no_branch.iter().sum::<u64>() > 0, "{w:?}");
+        }
+    }
+}

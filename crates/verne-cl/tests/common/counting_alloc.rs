@@ -1,7 +1,7 @@
 //! A global allocator that counts allocations (and reallocations) made by the threads that
 //! asked for it ([`count_this_thread`]), forwarding to the system allocator: other threads (the
 //! test harness's) do not disturb the count. Shared by `tests/alloc.rs` and
-//! `examples/throughput.rs`.
+//! `examples/cl_throughput.rs`.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;

@@ -97,8 +97,17 @@ pub(crate) fn tilt_frame_platform(
     pose: &ToolPose,
     tool_length: f64,
 ) -> Vector3<f64> {
+    tilt_frame_platform_sc(table, pose, pose.phi1.sin_cos(), tool_length)
+}
+
+/// [`tilt_frame_platform`] with (sin, cos) of phi1 given.
+pub(super) fn tilt_frame_platform_sc(
+    table: &TableGeometry,
+    pose: &ToolPose,
+    (s1, c1): (f64, f64),
+    tool_length: f64,
+) -> Vector3<f64> {
     let (s2, c2) = pose.phi2.sin_cos();
-    let (s1, c1) = pose.phi1.sin_cos();
     let u = pose.tip;
     // rot(z, -phi2) U + Delta rot(z, -phi2) a, with rot(z, -phi2) a = (0, -sin phi1, cos phi1).
     let q = Vector3::new(
@@ -111,7 +120,12 @@ pub(crate) fn tilt_frame_platform(
 
 /// P(theta1) = trans(z, d_a) rot(x, theta1) w, and its derivative in theta1, from
 /// (s, c) = sin, cos of theta1.
-fn platform_at(d_a: f64, w: &Vector3<f64>, s: f64, c: f64) -> (Vector3<f64>, Vector3<f64>) {
+pub(super) fn platform_at(
+    d_a: f64,
+    w: &Vector3<f64>,
+    s: f64,
+    c: f64,
+) -> (Vector3<f64>, Vector3<f64>) {
     let y = c * w.y - s * w.z;
     let z = s * w.y + c * w.z;
     (Vector3::new(w.x, y, d_a + z), Vector3::new(0.0, -z, y))
@@ -143,33 +157,33 @@ pub fn theta1_equation(m: &Machine, pose: &ToolPose, tool_length: f64) -> Trig {
 /// A tilting-axis angle with its sine and cosine (carried along Newton's steps, so that the
 /// polish needs no `sin_cos` per step), and the slider-1 position that goes with it.
 #[derive(Debug, Clone, Copy)]
-struct PathPoint {
-    theta1: f64,
-    sin: f64,
-    cos: f64,
-    rho1: f64,
+pub(super) struct PathPoint {
+    pub(super) theta1: f64,
+    pub(super) sin: f64,
+    pub(super) cos: f64,
+    pub(super) rho1: f64,
 }
 
 /// The leg-I equations along the path: g1 = u^2 + yp^2 + (zp - rho1)^2 - K1 (eq. (10), IFToMM
 /// 2007) and g2 = yp (R1 cos a - r1) + R1 sin a (zp - rho1) (eq. (14)), and their Jacobian in
 /// (theta1, rho1).
-struct Leg1Path<'a> {
-    m: &'a Machine,
-    w: Vector3<f64>,
-    sin_phi1: f64,
-    cos_phi1: f64,
+pub(super) struct Leg1Path<'a> {
+    pub(super) m: &'a Machine,
+    pub(super) w: Vector3<f64>,
+    pub(super) sin_phi1: f64,
+    pub(super) cos_phi1: f64,
 }
 
 impl Leg1Path<'_> {
     /// sin and cos of alpha = theta1 + phi1 (eq. (14), AIM 2007) by the angle-sum formulas.
-    fn alpha_sin_cos(&self, q: &PathPoint) -> (f64, f64) {
+    pub(super) fn alpha_sin_cos(&self, q: &PathPoint) -> (f64, f64) {
         (
             q.sin * self.cos_phi1 + q.cos * self.sin_phi1,
             q.cos * self.cos_phi1 - q.sin * self.sin_phi1,
         )
     }
 
-    fn eval(&self, q: &PathPoint) -> (Vector2<f64>, Matrix2<f64>) {
+    pub(super) fn eval(&self, q: &PathPoint) -> (Vector2<f64>, Matrix2<f64>) {
         let g = &self.m.module;
         let (r, rr) = (g.r_big1, g.r_small1);
         let (p, dp) = platform_at(self.m.table.d_a, &self.w, q.sin, q.cos);
@@ -192,7 +206,7 @@ impl Leg1Path<'_> {
 
     /// Newton from `start`: the best iterate (smallest residual), theta1 wrapped to (-pi, pi],
     /// with its residuals (g1, g2).
-    fn polish(&self, start: PathPoint) -> (PathPoint, Vector2<f64>) {
+    pub(super) fn polish(&self, start: PathPoint) -> (PathPoint, Vector2<f64>) {
         let mut cur = start;
         let (mut f, mut j) = self.eval(&cur);
         let mut best = (cur, f);
@@ -203,14 +217,7 @@ impl Leg1Path<'_> {
             if !step.iter().all(|v| v.is_finite()) {
                 break;
             }
-            let theta1 = cur.theta1 - step.x;
-            let (sin, cos) = sin_cos_after_step(cur.sin, cur.cos, theta1, step.x);
-            cur = PathPoint {
-                theta1,
-                sin,
-                cos,
-                rho1: cur.rho1 - step.y,
-            };
+            cur = cur.stepped(&step);
             (f, j) = self.eval(&cur);
             if f.amax() <= best.1.amax() {
                 best = (cur, f);
@@ -223,6 +230,21 @@ impl Leg1Path<'_> {
         }
         best.0.theta1 = wrap_angle(best.0.theta1);
         best
+    }
+}
+
+impl PathPoint {
+    /// The point minus `step` (theta1, rho1), its sine and cosine carried along.
+    #[inline(always)]
+    pub(super) fn stepped(&self, step: &Vector2<f64>) -> PathPoint {
+        let theta1 = self.theta1 - step.x;
+        let (sin, cos) = sin_cos_after_step(self.sin, self.cos, theta1, step.x);
+        PathPoint {
+            theta1,
+            sin,
+            cos,
+            rho1: self.rho1 - step.y,
+        }
     }
 }
 
@@ -325,6 +347,62 @@ fn polish_postures(
     pairs
 }
 
+/// The machine's branches on one leg-I posture `q` of the tool pose (phi1, theta2 = -phi2
+/// wrapped): legs II and III by eqs. (12)-(13), both signs each, labelled with the table's
+/// verdict, passed to `each` in order (s2, s3 = -1 before +1) when their configuration is
+/// `wanted` and their residual of eqs. (3)-(6) is within [`ACCEPT_RESIDUAL_MM`]. What
+/// [`machine_ik`] does for each posture, and the continuation for its one posture
+/// (`machine::continuation`): the same operations, so the same branch bit for bit.
+#[inline(always)]
+pub(super) fn posture_branches_each(
+    path: &Leg1Path,
+    q: &PathPoint,
+    phi1: f64,
+    theta2: f64,
+    cos_tilt: f64,
+    wanted: impl Fn(Config) -> bool,
+    mut each: impl FnMut(MachineIkBranch),
+) {
+    let m = path.m;
+    let (p, _) = platform_at(m.table.d_a, &path.w, q.sin, q.cos);
+    let (sin, cos) = path.alpha_sin_cos(q);
+    let leg1 = Leg1 {
+        alpha: wrap_angle(q.theta1 + phi1),
+        rho1: q.rho1,
+        sin,
+        cos,
+    };
+    let l1 = leg_state(m, 0, &p, sin, cos, q.rho1, cos_tilt).check();
+    let Some(four) = posture_branches(m, &p, &leg1, l1, cos_tilt) else {
+        return;
+    };
+    let mut table = Verdict::default();
+    if !theta1_in_limits(m, q.theta1) {
+        table.add(Reason::Theta1Range);
+    }
+    let module = ModulePose {
+        p,
+        alpha: leg1.alpha,
+    };
+    let (four, n) = distinct_branches(four);
+    for b in &four[..n] {
+        if !wanted(b.config)
+            || residual_mm_sc(&m.module, &module, &b.rho, sin, cos) > ACCEPT_RESIDUAL_MM
+        {
+            continue;
+        }
+        each(MachineIkBranch {
+            rho: b.rho,
+            theta1: q.theta1,
+            theta2,
+            alpha: leg1.alpha,
+            platform: p,
+            config: b.config,
+            verdict: b.verdict.with(table),
+        });
+    }
+}
+
 /// Every real inverse-kinematics branch of the machine for a tool pose in R_t (AIM 2007, section
 /// III.C), ordered by theta1 then by (s1, s2, s3). theta2 = -phi2 wrapped to (-pi, pi]. Empty
 /// when the pose is unreachable by any real branch (never because of a convergence failure: the
@@ -355,7 +433,7 @@ pub fn machine_ik_into(
     let g = &m.module;
     let (r, rr) = (g.r_big1, g.r_small1);
     let (sin_phi1, cos_phi1) = pose.phi1.sin_cos();
-    let w = tilt_frame_platform(&m.table, pose, tool_length);
+    let w = tilt_frame_platform_sc(&m.table, pose, (sin_phi1, cos_phi1), tool_length);
     // Every platform point of the pose beyond the rods' reach from the strokes: no branch
     // within them, proved before F's coefficients lose their digits to the pose's size.
     if ReachBox::of(m).circle_beyond(w.x, m.table.d_a, w.y, w.z) {
@@ -423,44 +501,19 @@ pub fn machine_ik_into(
     let theta2 = wrap_angle(-pose.phi2);
     let cos_tilt = cos_tilt_max(m);
     for q in &pairs {
-        let (p, _) = platform_at(m.table.d_a, &path.w, q.sin, q.cos);
-        let (sin, cos) = path.alpha_sin_cos(q);
-        let leg1 = Leg1 {
-            alpha: wrap_angle(q.theta1 + pose.phi1),
-            rho1: q.rho1,
-            sin,
-            cos,
-        };
-        // The module's four branches on this posture: legs II and III by eqs. (12)-(13).
-        let l1 = leg_state(m, 0, &p, sin, cos, q.rho1, cos_tilt).check();
-        let Some(four) = posture_branches(m, &p, &leg1, l1, cos_tilt) else {
-            continue;
-        };
-        let mut table = Verdict::default();
-        if !theta1_in_limits(m, q.theta1) {
-            table.add(Reason::Theta1Range);
-        }
-        let module = ModulePose {
-            p,
-            alpha: leg1.alpha,
-        };
-        let (four, n) = distinct_branches(four);
-        for b in &four[..n] {
-            if residual_mm_sc(g, &module, &b.rho, sin, cos) > ACCEPT_RESIDUAL_MM {
-                continue;
-            }
-            if !out.is_full() {
-                out.push(MachineIkBranch {
-                    rho: b.rho,
-                    theta1: q.theta1,
-                    theta2,
-                    alpha: leg1.alpha,
-                    platform: p,
-                    config: b.config,
-                    verdict: b.verdict.with(table),
-                });
-            }
-        }
+        posture_branches_each(
+            &path,
+            q,
+            pose.phi1,
+            theta2,
+            cos_tilt,
+            |_| true,
+            |b| {
+                if !out.is_full() {
+                    out.push(b);
+                }
+            },
+        );
     }
     out.certificate = certificate;
     out.mark_unproved(|b| &mut b.verdict);

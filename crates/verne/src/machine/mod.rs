@@ -15,10 +15,13 @@
 //! - [`ik`]: inverse kinematics, every real branch of a tool pose;
 //! - [`fk`]: forward kinematics, every assembly mode of the joints;
 //! - [`orientation`]: the tool axis and the angles (phi1, phi2);
-//! - [`path`]: one branch per row along a toolpath, continuously.
+//! - [`path`]: one branch per row along a toolpath, continuously;
+//! - [`continuation`]: the branch that continues the previous joints, proved from them alone
+//!   where it can be (a controller's servo loop), else from every branch.
 
 use nalgebra::Vector3;
 
+pub mod continuation;
 pub mod fk;
 pub mod ik;
 pub mod intended;
@@ -26,6 +29,10 @@ pub mod orientation;
 pub mod path;
 pub mod transforms;
 
+pub use continuation::{
+    Continued, Fallback, NoBranch, PreviousJoints, choose_continuation, continue_branch,
+    continue_locally, joint_distance,
+};
 pub use fk::{MAX_MACHINE_FK_MODES, MachineFkMode, MachineFkModes, machine_fk};
 #[cfg(test)]
 pub(crate) use ik::tilt_frame_platform;

@@ -284,7 +284,9 @@ pub fn outer_leg_labels(
     dx_dy_h: (f64, f64, f64),
     cos_tilt_max: f64,
 ) -> [(i8, Verdict); 2] {
-    outer_leg_pair(leg, dx_dy_h, cos_tilt_max, |_| false).map(LegState::check)
+    // Element by element: `map` on the array was a call of its own on the inverse's hot path.
+    let [lower, upper] = outer_leg_pair(leg, dx_dy_h, cos_tilt_max, |_| false);
+    [lower.check(), upper.check()]
 }
 
 /// The states of [`outer_leg_states`], root k outside its stroke when `outside(k)`.

@@ -127,7 +127,24 @@ fn jacobian_at(v: &[Vector3<f64>; 4], g: &ModuleGeometry, s: f64, c: f64) -> Mat
 /// d(residuals)/d(rho1, rho2, rho3) (4x3). The serial Jacobian of the comparative study is its
 /// negative; a zero entry in a rod's row is a serial singularity (rod perpendicular to its slider).
 pub fn jacobian_sliders(g: &ModuleGeometry, pose: &ModulePose, rho: &Sliders) -> Matrix4x3<f64> {
-    let v = rod_vectors(g, pose, rho);
+    sliders_at(&rod_vectors(g, pose, rho))
+}
+
+/// [`jacobian_pose`] and [`jacobian_sliders`] from one evaluation of the rod vectors: the same
+/// matrices, bit for bit.
+pub fn jacobians(
+    g: &ModuleGeometry,
+    pose: &ModulePose,
+    rho: &Sliders,
+) -> (Matrix4<f64>, Matrix4x3<f64>) {
+    let (s, c) = pose.alpha.sin_cos();
+    let v = rod_vectors_sc(g, pose, rho, s, c);
+    (jacobian_at(&v, g, s, c), sliders_at(&v))
+}
+
+/// [`jacobian_sliders`] from the rod vectors.
+#[inline]
+fn sliders_at(v: &[Vector3<f64>; 4]) -> Matrix4x3<f64> {
     let mut b = Matrix4x3::zeros();
     b[(0, 0)] = -2.0 * v[0].z;
     b[(1, 0)] = -2.0 * v[1].z;

@@ -2,7 +2,7 @@
 //! allocations per row in the steady state (counting allocator), and the time of very long
 //! lines and records at two sizes (linear time shows as a ratio near the size ratio).
 //!
-//! `cargo run --release --example throughput [ROWS]`; the file is written to the temp dir.
+//! `cargo run --release -p verne-cl --example cl_throughput [ROWS]`; the file is written to the temp dir.
 
 use std::fs::File;
 use std::io::{BufReader, BufWriter, Write};

@@ -2,7 +2,7 @@
 //! post writes them (`N.. G1 X.. Y.. Z.. A.. C..`, a feed every 50 blocks, an arc every 1000),
 //! read from a file on one thread; and the time of one block per core-second budget.
 //!
-//! `cargo run --release -p verne-gcode --example throughput [BLOCKS]`; the file is written to
+//! `cargo run --release -p verne-gcode --example gcode_throughput [BLOCKS]`; the file is written to
 //! the temp dir and removed.
 
 use std::fs::File;
