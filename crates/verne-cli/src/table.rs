@@ -20,6 +20,9 @@ pub struct CsvSource {
     headers: ByteRecord,
 }
 
+/// Rows of numbers, each with its line: the command line's, or another reader's.
+pub type NumberRows = Box<dyn Iterator<Item = Result<(u64, Vec<f64>), VerneError>> + Send>;
+
 /// One row of a table as read: a CSV record's cells, or the numbers of a command-line row.
 #[derive(Debug, Default, Clone)]
 pub struct TableRow {
@@ -40,9 +43,8 @@ enum Records {
         raw: ByteRecord,
     },
     Numbers {
-        rows: std::vec::IntoIter<Vec<f64>>,
-        /// The number of rows read so far.
-        read: u64,
+        /// Each row's line and numbers.
+        rows: NumberRows,
     },
 }
 
@@ -108,11 +110,22 @@ impl CsvSource {
 
     /// Rows of numbers given on the command line, under the column names `header`.
     pub fn from_numbers(header: &[&str], rows: Vec<Vec<f64>>, name: &str) -> CsvSource {
+        let rows = rows
+            .into_iter()
+            .enumerate()
+            .map(|(k, r)| Ok((k as u64 + 1, r)));
+        CsvSource::from_number_rows(header, Box::new(rows), name)
+    }
+
+    /// Rows of numbers from another reader (a G-code joint program's joints), each with its
+    /// line, under the column names `header`.
+    pub fn from_number_rows(
+        header: &[&str],
+        rows: NumberRows,
+        name: &str,
+    ) -> CsvSource {
         CsvSource {
-            records: Records::Numbers {
-                rows: rows.into_iter(),
-                read: 0,
-            },
+            records: Records::Numbers { rows },
             name: name.to_string(),
             headers: ByteRecord::from(header.to_vec()),
         }
@@ -201,14 +214,14 @@ impl CsvSource {
     /// surrounding ASCII white space removed.
     pub fn read_row(&mut self, row: &mut TableRow) -> Result<bool, VerneError> {
         match &mut self.records {
-            Records::Numbers { rows, read } => {
-                let Some(numbers) = rows.next() else {
+            Records::Numbers { rows } => {
+                let Some(next) = rows.next() else {
                     return Ok(false);
                 };
-                *read += 1;
+                let (line, numbers) = next?;
                 row.record.clear();
                 row.numbers = numbers;
-                row.line = *read;
+                row.line = line;
                 Ok(true)
             }
             Records::Text { .. } => {

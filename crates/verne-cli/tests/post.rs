@@ -211,3 +211,61 @@ fn unlinearized_programs_are_found_off_the_intended_move() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `verne fk` reads a joint program: the tool poses of the blocks that end on a path row are
+/// the path's (to the joint words' rounding), inserted ones lie on their move.
+#[test]
+fn fk_turns_a_posted_program_back_into_the_path() {
+    let dir = std::env::temp_dir().join(format!("verne-post-fk-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let post = dir.join("post.ngc");
+    let path = "tests/data/post/long.cl";
+    let ik = run(
+        &[
+            "ik",
+            path,
+            "--format",
+            "gcode",
+            "-o",
+            post.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert_eq!(ik.status.code(), Some(0));
+    let fk = run(&["fk", post.to_str().unwrap()], None);
+    assert_eq!(
+        fk.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&fk.stderr)
+    );
+    let (h, rows) = common::table_of(&fk);
+    let program = blocks(&std::fs::read_to_string(&post).unwrap());
+    assert_eq!(rows.len(), program.len());
+    let text = std::fs::read(format!("{}/{path}", common::ROOT)).unwrap();
+    let (cl, _) = verne_cl::read_all(path, &text, &verne_cl::Options::default()).unwrap();
+    for (r, b) in rows.iter().zip(&program) {
+        let tip = Vector3::new(
+            r[common::col(&h, "x")].parse::<f64>().unwrap(),
+            r[common::col(&h, "y")].parse::<f64>().unwrap(),
+            r[common::col(&h, "z")].parse::<f64>().unwrap(),
+        );
+        let want = Vector3::from(cl[b.row - 1].tip);
+        let start = if b.row > 1 {
+            Vector3::from(cl[b.row - 2].tip)
+        } else {
+            want
+        };
+        let on = match b.fraction {
+            None => want,
+            Some(s) => start + (want - start) * s,
+        };
+        assert!(
+            (tip - on).norm() < 1e-4,
+            "block to row {} at {:?}: {tip} vs {on}",
+            b.row,
+            b.fraction
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -15,6 +15,17 @@ use super::{EXIT_OK, EXIT_ROWS_FAILED, load_machine, write_stdout};
 use crate::cli::{VerifyArgs, VerifyFormat};
 
 pub fn run(args: &VerifyArgs) -> Result<u8, VerneError> {
+    let result = checked(args);
+    if let (Err(e), VerifyFormat::Json) = (&result, args.format)
+        && !e.is_broken_pipe()
+    {
+        // A script reading the JSON gets an object whatever happened.
+        let _ = write_stdout(&format!("{}\n", crate::report::verify::error_json(e)));
+    }
+    result
+}
+
+fn checked(args: &VerifyArgs) -> Result<u8, VerneError> {
     let summary_to_stdout = args.summary.as_ref().is_some_and(|p| p.as_os_str() == "-");
     if summary_to_stdout && args.format == VerifyFormat::Json {
         return Err(VerneError::Usage(
@@ -61,7 +72,13 @@ pub fn run(args: &VerifyArgs) -> Result<u8, VerneError> {
         Some(p) => {
             let mut s = Sink::create(Some(p))?;
             s.write(&ByteRecord::from(vec![
-                "row", "check", "value", "limit", "detail",
+                "row",
+                "check",
+                "value",
+                "limit",
+                "detail",
+                "joints_line",
+                "path_line",
             ]))?;
             Some(s)
         }
@@ -76,6 +93,9 @@ pub fn run(args: &VerifyArgs) -> Result<u8, VerneError> {
             rec.push_field(short_number(v.value).as_bytes());
             rec.push_field(short_number(v.limit).as_bytes());
             rec.push_field(v.detail.as_bytes());
+            let line = |l: Option<u64>| l.map_or(String::new(), |l| l.to_string());
+            rec.push_field(line(v.joints_line).as_bytes());
+            rec.push_field(line(v.path_line).as_bytes());
             s.write(&rec)?;
         }
         Ok(())
