@@ -119,11 +119,7 @@ impl CsvSource {
 
     /// Rows of numbers from another reader (a G-code joint program's joints), each with its
     /// line, under the column names `header`.
-    pub fn from_number_rows(
-        header: &[&str],
-        rows: NumberRows,
-        name: &str,
-    ) -> CsvSource {
+    pub fn from_number_rows(header: &[&str], rows: NumberRows, name: &str) -> CsvSource {
         CsvSource {
             records: Records::Numbers { rows },
             name: name.to_string(),
@@ -629,6 +625,56 @@ fn check_output_target(path: &Path) -> io::Result<()> {
     Ok(())
 }
 
+/// What an output is, to tell two of one run apart: standard output, an existing file (device
+/// and inode: the same file under any name), or a file to be (its folder resolved).
+#[derive(Debug, PartialEq)]
+enum OutputIdentity {
+    Stdout,
+    Inode(u64, u64),
+    Path(PathBuf),
+}
+
+fn output_identity(path: &Path) -> OutputIdentity {
+    use std::os::unix::fs::MetadataExt;
+    if path.as_os_str() == "-" || path == Path::new("/dev/stdout") {
+        return OutputIdentity::Stdout;
+    }
+    if let Ok(m) = std::fs::metadata(path) {
+        return OutputIdentity::Inode(m.dev(), m.ino());
+    }
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let dir = std::fs::canonicalize(dir).unwrap_or_else(|_| dir.to_path_buf());
+    OutputIdentity::Path(dir.join(path.file_name().unwrap_or_default()))
+}
+
+/// Refuses, before any work, two outputs of one run that are the same file (the same path once
+/// resolved, or the same inode) or that both write standard output: one would replace or mix
+/// with the other. `outputs` are (option, path) pairs.
+pub fn check_distinct_outputs(outputs: &[(&str, &Path)]) -> Result<(), VerneError> {
+    let ids: Vec<OutputIdentity> = outputs.iter().map(|(_, p)| output_identity(p)).collect();
+    for i in 0..outputs.len() {
+        for j in i + 1..outputs.len() {
+            if ids[i] != ids[j] {
+                continue;
+            }
+            let ((a, pa), (b, pb)) = (outputs[i], outputs[j]);
+            return Err(VerneError::Usage(if ids[i] == OutputIdentity::Stdout {
+                format!("{a} and {b} both write standard output: give one of them a file")
+            } else {
+                format!(
+                    "{a} {} and {b} {} are the same file: each output of a run needs a file of its own",
+                    pa.display(),
+                    pb.display()
+                )
+            }));
+        }
+    }
+    Ok(())
+}
+
 /// Writes `bytes` as the output file `path`, as [`Sink`] does: through a temporary file beside
 /// it, renamed into place (nothing is left behind on an error), or in place for a device or a
 /// FIFO ([`output_destination`]).
@@ -971,6 +1017,35 @@ pub(crate) mod tests {
         fn flush(&mut self) -> io::Result<()> {
             Ok(())
         }
+    }
+
+    #[test]
+    fn two_outputs_of_one_run_are_different_files() {
+        let dir = std::env::temp_dir().join(format!("verne-outputs-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let a = dir.join("a.csv");
+        std::fs::write(&a, "x").unwrap();
+        let link = dir.join("b.csv");
+        let _ = std::fs::remove_file(&link);
+        std::fs::hard_link(&a, &link).unwrap();
+        let dotted = dir.join(".").join("c.csv");
+        let plain = dir.join("c.csv");
+        let same = [
+            (a.as_path(), a.as_path()),
+            (a.as_path(), link.as_path()),
+            (dotted.as_path(), plain.as_path()),
+            (Path::new("-"), Path::new("/dev/stdout")),
+        ];
+        for (p, q) in same {
+            assert!(
+                check_distinct_outputs(&[("-o", p), ("--plot", q)]).is_err(),
+                "{p:?} {q:?}"
+            );
+        }
+        assert!(
+            check_distinct_outputs(&[("-o", a.as_path()), ("--plot", plain.as_path())]).is_ok()
+        );
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]

@@ -1,6 +1,8 @@
 //! `verne verify`: a postprocessor's joint table against the intended path (docs/verify.md).
 //! Opens the files, writes the report CSV atomically, prints the summary, picks the exit code.
 
+use std::path::Path;
+
 use crate::error::VerneError;
 use crate::input::recording::{DEFAULT_COLUMNS, RecordingReader, parse_columns};
 use crate::input::verify_files::{JointInput, PathReader};
@@ -26,6 +28,18 @@ pub fn run(args: &VerifyArgs) -> Result<u8, VerneError> {
 }
 
 fn checked(args: &VerifyArgs) -> Result<u8, VerneError> {
+    let stdout = Path::new("-");
+    let mut outputs: Vec<(&str, &Path)> = Vec::new();
+    if let Some(r) = &args.report {
+        outputs.push(("--report", r));
+    }
+    if let Some(s) = &args.summary {
+        outputs.push(("--summary", s));
+    }
+    if args.format == VerifyFormat::Json {
+        outputs.push(("--format json", stdout));
+    }
+    crate::table::check_distinct_outputs(&outputs)?;
     let summary_to_stdout = args.summary.as_ref().is_some_and(|p| p.as_os_str() == "-");
     if summary_to_stdout && args.format == VerifyFormat::Json {
         return Err(VerneError::Usage(

@@ -301,6 +301,28 @@ fn run_adaptive(
 }
 
 pub fn run(args: &WorkspaceArgs) -> Result<u8, VerneError> {
+    // Every output of the run, pictures of several tool lengths included, a file of its own.
+    let mut outputs: Vec<(String, PathBuf)> = Vec::new();
+    if let Some(o) = &args.output {
+        outputs.push(("-o".into(), o.clone()));
+    }
+    if let Some(p) = &args.plot {
+        if args.tool_length.len() > 1 && args.sweep.is_empty() {
+            for &l in &args.tool_length {
+                outputs.push((
+                    format!("--plot (tool length {l})"),
+                    plot_path(p, &args.tool_length, l),
+                ));
+            }
+        } else {
+            outputs.push(("--plot".into(), p.clone()));
+        }
+    }
+    let named: Vec<(&str, &Path)> = outputs
+        .iter()
+        .map(|(o, p)| (o.as_str(), p.as_path()))
+        .collect();
+    crate::table::check_distinct_outputs(&named)?;
     if let Some(spec) = super::glider::load(args.common.machine.as_deref())? {
         // The options of the VERNE machine's workspace have no meaning for a planar glider:
         // refused, not ignored.
