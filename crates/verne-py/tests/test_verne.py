@@ -26,7 +26,7 @@ def test_machine_files():
 
 
 def test_inverse_kinematics_reference_pose():
-    # verne-geometry.md: P = (-240, -86, 1000) has sixteen real branches, four alphas.
+    # docs/reference-results.md: P = (-240, -86, 1000) has sixteen real branches, four alphas.
     b, config, working, count, proved = verne.module_ik(M, np.array([[-240.0, -86.0, 1000.0]]))
     assert b.shape == (1, 24, 4) and config.dtype == np.int8 and working.dtype == bool
     assert count[0] == 16 and proved[0]

@@ -76,7 +76,11 @@ pub struct RecordingReader {
 impl RecordingReader {
     /// Opens `path` (`-`: stdin).
     pub fn open(path: &Path, columns: Vec<Column>, period: f64) -> Result<Self, VerneError> {
-        let name = path.display().to_string();
+        let name = if path.as_os_str() == "-" {
+            "<stdin>".to_string()
+        } else {
+            path.display().to_string()
+        };
         let input: Box<dyn BufRead + Send> = if path.as_os_str() == "-" {
             Box::new(std::io::BufReader::new(std::io::stdin()))
         } else {
@@ -220,7 +224,7 @@ impl RowSource for RecordingReader {
             }
             // A tag is halsampler's sample number: an integer, each above the one before.
             if let Some(v) = tag {
-                if v.fract() != 0.0 || v < 0.0 || v > 9.007e15 {
+                if v.fract() != 0.0 || !(0.0..=9.007e15).contains(&v) {
                     return Err(self.error(
                         Some("tag"),
                         format!("expected a sample number (a whole number from 0), found {v}"),
