@@ -405,7 +405,7 @@ impl Sink {
     }
 
     /// Passes everything written through `wrap` (a writer that turns the CSV into another
-    /// format, such as [`crate::post::GcodePost`]); call before the first write.
+    /// format, such as [`crate::follow::write::GcodeProgram`]); call before the first write.
     pub fn wrap(&mut self, wrap: impl FnOnce(Box<dyn Write + Send>) -> Box<dyn Write + Send>) {
         let inner = std::mem::replace(&mut self.writer, Box::new(io::sink()));
         self.writer = wrap(inner);

@@ -8,8 +8,10 @@
 //! Two ways to know it: at one s ([`deviation_at`], what `verne verify` samples), and over an
 //! interval of s with a proof ([`deviation_bound`], what the post's linearization certifies with).
 //! The bound is the mean-value form e(S) ⊆ e(s_m) + e'(S) (S - s_m), with the module's pose and
-//! its rate enclosed by [`enclose_segment`] and the tool pose's rate by
-//! [`tool_pose_over`](crate::machine::transforms::tool_pose_over): every s of the interval is
+//! its rate enclosed by
+//! [`enclose_segment_and_middle`]
+//! and the tool pose's rate by [`crate::machine::transforms::tool_pose_over`]: every s of the
+//! interval is
 //! covered, not only samples.
 
 use nalgebra::Vector3;
