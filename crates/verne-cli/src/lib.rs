@@ -119,7 +119,7 @@ pub fn run() -> ExitCode {
             // Errors are written whatever the verbosity.
             use std::io::Write as _;
             let _ = writeln!(std::io::stderr(), "verne: error: {e}");
-            ExitCode::from(cmd::EXIT_FATAL)
+            ExitCode::from(e.exit_code())
         }
     }
 }

@@ -283,8 +283,12 @@ fn follow_path(
     }
     if let Err(mut e) = result {
         sink.discard();
+        let input = match &mut e {
+            VerneError::RowFailed(inner) => inner.as_mut(),
+            other => other,
+        };
         if let (Some(_), true, VerneError::Input { message, .. }) =
-            (program, to_stdout(output), &mut e)
+            (program, to_stdout(output), input)
         {
             // A file is never left partial; a pipe may have received the rows before.
             message.push_str(

@@ -350,14 +350,14 @@ impl Follower {
         }
         let status = status_text(f.status());
         if let Some(what) = every_row {
-            return Err(VerneError::input(
+            return Err(VerneError::RowFailed(Box::new(VerneError::input(
                 file,
                 Some(f.row.line),
                 None,
                 format!(
-                    "row status `{status}`: {what} cannot leave out a row; fix the path or use CSV output to see every row's status"
+                    "row status `{status}`: {what} cannot leave out a row; fix the path or use CSV output to see every row's status (exit 1)"
                 ),
-            ));
+            ))));
         }
         self.summary.count(&status, f.row.line);
         Ok(())

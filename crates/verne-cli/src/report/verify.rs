@@ -138,6 +138,9 @@ fn with_lines(w: &verne::verify::Violation) -> String {
 /// and column when the error has them, and the message.
 pub fn error_json(e: &crate::error::VerneError) -> String {
     use crate::error::VerneError;
+    if let VerneError::RowFailed(inner) = e {
+        return error_json(inner);
+    }
     let (file, line, column, message) = match e {
         VerneError::Input {
             file,
