@@ -88,7 +88,7 @@ pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
     }
     crate::arg_values::spatial(&args.pose, "--pose", "XP,YP,ZP").map_err(VerneError::Usage)?;
     if let (Some(o), Some(r)) = (&args.output, &args.schedule_report) {
-        crate::table::check_distinct_outputs(&[("-o", o), ("--schedule-report", r)])?;
+        crate::files::check_distinct_outputs(&[("-o", o), ("--schedule-report", r)])?;
     }
     if !args.pose.is_empty() {
         let source = inline_source(
@@ -394,8 +394,8 @@ fn write_schedule_report(path: &Path, lines: &[ScheduleLine]) -> Result<(), Vern
             l.block, l.line, l.share, l.feed_time_s, l.time_s
         ));
     }
-    crate::table::check_output_path(path)
-        .and_then(|_| crate::table::write_output(path, text.as_bytes()))
+    crate::files::check_output_path(path)
+        .and_then(|_| crate::files::write_output(path, text.as_bytes()))
         .map_err(|e| VerneError::io(&path.display().to_string(), e))
 }
 

@@ -18,7 +18,8 @@ use std::time::Duration;
 
 use crate::engine::pipeline::{self, RowJob, RunSummary, Units};
 use crate::error::VerneError;
-use crate::table::{CsvSource, Sink};
+use crate::files::Sink;
+use crate::table::CsvSource;
 use verne::spec::Machine;
 
 use crate::cli::CommonArgs;
@@ -86,7 +87,7 @@ fn read_machine(path: Option<&Path>) -> Result<Machine, VerneError> {
         Some(p) if !p.exists() && p.as_os_str() == "verne" => Ok(Machine::default_verne()),
         Some(p) => {
             let name = p.display().to_string();
-            let text = crate::table::read_input_file(p).map_err(|e| VerneError::io(&name, e))?;
+            let text = crate::files::read_input_file(p).map_err(|e| VerneError::io(&name, e))?;
             let text = String::from_utf8(text).map_err(|e| {
                 let upto = &e.as_bytes()[..e.utf8_error().valid_up_to()];
                 let line = upto.iter().filter(|&&b| b == b'\n').count() as u64 + 1;
@@ -107,7 +108,7 @@ fn read_machine(path: Option<&Path>) -> Result<Machine, VerneError> {
                     ));
                 }
                 let shown = path.display().to_string();
-                let bytes = crate::table::read_input_file(&path)
+                let bytes = crate::files::read_input_file(&path)
                     .map_err(|e| format!("base {shown}: {e}"))?;
                 String::from_utf8(bytes)
                     .map(|t| (t, shown.clone()))

@@ -4,10 +4,10 @@
 use std::path::Path;
 
 use crate::error::VerneError;
+use crate::files::Sink;
 use crate::input::recording::{DEFAULT_COLUMNS, RecordingReader, parse_columns};
 use crate::input::verify_files::{JointInput, PathReader};
 use crate::report::verify::{short_number, summary_json, summary_text};
-use crate::table::Sink;
 use crate::toolpath::ReaderReport;
 use csv::ByteRecord;
 use verne::verify::contour::{ContourPath, verify_recording};
@@ -39,7 +39,7 @@ fn checked(args: &VerifyArgs) -> Result<u8, VerneError> {
     if args.format == VerifyFormat::Json {
         outputs.push(("--format json", stdout));
     }
-    crate::table::check_distinct_outputs(&outputs)?;
+    crate::files::check_distinct_outputs(&outputs)?;
     let summary_to_stdout = args.summary.as_ref().is_some_and(|p| p.as_os_str() == "-");
     if summary_to_stdout && args.format == VerifyFormat::Json {
         return Err(VerneError::Usage(

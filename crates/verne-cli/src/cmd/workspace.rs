@@ -7,10 +7,10 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use crate::error::VerneError;
+use crate::files::Sink;
 use crate::plot::sweep::{SweepPoint, VOLUME_LABELS, sweep_picture};
 use crate::plot::{self, View};
 use crate::report::workspace::{POINTS_HEADER, write_point};
-use crate::table::Sink;
 use csv::ByteRecord;
 use nalgebra::Vector3;
 use verne::workspace::{
@@ -341,7 +341,7 @@ pub fn run(args: &WorkspaceArgs) -> Result<u8, VerneError> {
         .iter()
         .map(|(o, p)| (o.as_str(), p.as_path()))
         .collect();
-    crate::table::check_distinct_outputs(&named)?;
+    crate::files::check_distinct_outputs(&named)?;
     if let Some(spec) = super::glider::load(args.common.machine.as_deref())? {
         // The options of the VERNE machine's workspace have no meaning for a planar glider:
         // refused, not ignored.

@@ -84,7 +84,7 @@ impl RecordingReader {
         let input: Box<dyn BufRead + Send> = if path.as_os_str() == "-" {
             Box::new(std::io::BufReader::new(std::io::stdin()))
         } else {
-            let f = crate::table::open_input_file(path).map_err(|e| VerneError::io(&name, e))?;
+            let f = crate::files::open_input_file(path).map_err(|e| VerneError::io(&name, e))?;
             Box::new(std::io::BufReader::with_capacity(64 * 1024, f))
         };
         Ok(Self::from_reader(input, &name, columns, period))
