@@ -1,7 +1,8 @@
 //! The machine's kinematics in three calls: [`Machine::inverse`] (every branch of a tool pose),
 //! [`Machine::forward`] (every assembly mode of the joints) and [`Machine::follow`] (one branch
-//! per row along a toolpath), each with the machine's own tool length
-//! ([`Machine::with_tool_length`] for another one).
+//! per row along a toolpath; [`Machine::follow_path`] for a whole path at once, as `verne ik`
+//! follows it), each with the machine's own tool length ([`Machine::with_tool_length`] for
+//! another one).
 //!
 //! ```
 //! use verne::{Machine, ToolOrientation, Vector3};
@@ -34,7 +35,8 @@ use nalgebra::Vector3;
 
 use crate::machine::orientation::ToolOrientation;
 use crate::machine::{
-    MachineFkModes, PathCandidates, PathError, PathRow, PathState, machine_fk, path_candidates,
+    FirstRowChoice, MachineFkModes, PathCandidates, PathError, PathRow, PathState,
+    first_decided_theta2, machine_fk, path_candidates,
 };
 use crate::parallel_module::equations::Sliders;
 use crate::spec::Machine;
@@ -71,6 +73,57 @@ impl Machine {
             machine: self,
             state: PathState::default(),
         }
+    }
+
+    /// The joints of a whole toolpath, as `verne ik` follows it: one working branch per pose,
+    /// continuous from the one before, the first chosen by `first`. A path that starts with
+    /// the tool inside the rotary axis's singular cone (on the table normal, as a CL file's
+    /// FROM) takes the theta2 of its first pose outside it from the start, so the rotary axis
+    /// does not swing on the first tilted move. A pose that is not finite is an error of its
+    /// own and the next continues from the last with joints.
+    ///
+    /// ```
+    /// use verne::machine::FirstRowChoice;
+    /// use verne::{Machine, ToolOrientation, Vector3};
+    ///
+    /// let machine = Machine::default_verne();
+    /// let up = ToolOrientation::Axis(Vector3::new(0.0, 0.0, 1.0));
+    /// let tilted = ToolOrientation::Axis(Vector3::new(0.0, 0.5, 0.75f64.sqrt()));
+    /// let path = [
+    ///     (Vector3::new(0.0, 0.0, 60.0), up),
+    ///     (Vector3::new(10.0, 0.0, 30.0), tilted),
+    /// ];
+    /// let rows = machine.follow_path(&path, FirstRowChoice::SmallestTheta1);
+    /// let (a, b) = (rows[0].as_ref().unwrap(), rows[1].as_ref().unwrap());
+    /// // The rotary axis is already where the tilted pose needs it.
+    /// assert!((a.theta2 - b.theta2).abs() < 1e-12);
+    /// ```
+    pub fn follow_path(
+        &self,
+        poses: &[(Vector3<f64>, ToolOrientation)],
+        first: FirstRowChoice,
+    ) -> Vec<Result<PathRow, PathError>> {
+        let finite = |(tip, orientation): &&(Vector3<f64>, ToolOrientation)| {
+            tip.iter().all(|v| v.is_finite())
+                && match orientation {
+                    ToolOrientation::Axis(a) => a.iter().all(|v| v.is_finite()),
+                    ToolOrientation::Angles(a) => a.phi1.is_finite() && a.phi2.is_finite(),
+                }
+        };
+        let seed = first_decided_theta2(
+            self,
+            poses.iter().filter(finite).copied(),
+            self.tool_length,
+            first,
+        );
+        let mut state = match seed {
+            Some(theta2) => PathState::with_theta2(first, theta2),
+            None => PathState::new(first),
+        };
+        poses
+            .iter()
+            .map(|(tip, orientation)| state.next_row(self, tip, orientation, self.tool_length))
+            .collect()
     }
 
     /// This machine with another tool length Delta (mm, AIM 2007 eq. (8)); `None` unless it is
