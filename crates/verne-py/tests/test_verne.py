@@ -199,5 +199,6 @@ def test_results_are_named_and_unpack_in_order():
         if isinstance(node, ast.ClassDef)
     }
     for name in ["ModuleBranches", "CompactBranches", "ModuleWorking", "PathJoints", "ToolPoses",
-                 "MachineBranches", "MachineModes", "Jacobians", "GliderSolutions", "GliderModes"]:
+                 "MachineBranches", "MachineModes", "Jacobians", "GliderSolutions", "GliderModes",
+                 "Verification"]:
         assert classes[name] == list(getattr(verne, name)._fields), name

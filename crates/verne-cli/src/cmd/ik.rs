@@ -355,18 +355,18 @@ fn follow_path(
 fn report_post(cmd: &str, name: &str, r: &PostReport, program: bool) {
     if r.inserted > 0 || !r.not_linearized.is_empty() {
         sayln!(
-            "verne {cmd}: {name}: linearized: {} rows, {} poses inserted",
-            r.rows,
-            r.inserted
+            "verne {cmd}: {name}: linearized: {}, {} inserted",
+            counted(r.rows, "row", "rows"),
+            counted(r.inserted, "pose", "poses")
         );
     }
     if r.timed_blocks > 0 {
         sayln!(
-            "verne {cmd}: {name}: scheduled: {} feed blocks in {:.3} s ({:.3} s at the programmed feeds alone); {} blocks slowed by the drives' limits",
-            r.timed_blocks,
+            "verne {cmd}: {name}: scheduled: {} in {:.3} s ({:.3} s at the programmed feeds alone); {} slowed by the drives' limits",
+            counted(r.timed_blocks, "feed block", "feed blocks"),
             r.time_s,
             r.feed_time_s,
-            r.slowed
+            counted(r.slowed, "block", "blocks")
         );
     }
     for (line, why) in &r.not_linearized {
@@ -374,10 +374,18 @@ fn report_post(cmd: &str, name: &str, r: &PostReport, program: bool) {
     }
     if !r.not_linearized.is_empty() && program {
         sayln!(
-            "verne {cmd}: {name}: no program written: {} moves cannot be linearized within the tolerances (exit 1)",
-            r.not_linearized.len()
+            "verne {cmd}: {name}: no program written: {} linearized within the tolerances (exit 1)",
+            match r.not_linearized.len() {
+                1 => "1 move cannot be".to_string(),
+                n => format!("{n} moves cannot be"),
+            }
         );
     }
+}
+
+/// `n` with its noun, singular for one.
+fn counted(n: u64, one: &str, many: &str) -> String {
+    format!("{n} {}", if n == 1 { one } else { many })
 }
 
 /// Writes the schedule report (CSV, atomically).

@@ -33,7 +33,6 @@ from ._verne import (  # noqa: F401
     design_tables,
     glider_workspace,
     kinetostatics,
-    verify,
     workspace,
 )
 
@@ -196,6 +195,15 @@ class GliderModes(_NamedTuple):
     """[N] bool: C = D with equal struts (P anywhere on a circle, count 0)."""
 
 
+class Verification(_NamedTuple):
+    """What `verify` found: each finding, and the summary of every check."""
+
+    findings: list
+    """One dict per finding: row, check, value, limit, detail, severity."""
+    summary: dict
+    """`clean`, `rows`, and per check its count and worst value."""
+
+
 def _named(raw, result):
     """`raw` (a function of the extension) returning `result` (a NamedTuple) for its tuple."""
 
@@ -216,6 +224,7 @@ machine_fk_working = _named(_verne.machine_fk_working, ToolPoses)
 machine_ik = _named(_verne.machine_ik, MachineBranches)
 machine_fk = _named(_verne.machine_fk, MachineModes)
 jacobian = _named(_verne.jacobian, Jacobians)
+verify = _named(_verne.verify, Verification)
 glider_ik = _named(_verne.glider_ik, GliderSolutions)
 
 
@@ -238,6 +247,7 @@ __all__ = [
     "Jacobians",
     "GliderSolutions",
     "GliderModes",
+    "Verification",
     "module_ik",
     "module_ik_working",
     "module_fk",

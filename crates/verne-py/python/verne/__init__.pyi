@@ -185,6 +185,14 @@ def jacobian(
 def kinetostatics(
     machine: Machine, poses: npt.NDArray[np.float64], sliders: npt.NDArray[np.float64]
 ) -> Dict[str, npt.NDArray[np.float64]]: ...
+class Verification(NamedTuple):
+    """What `verify` found: each finding, and the summary of every check."""
+
+    findings: List[Dict[str, Any]]
+    """One dict per finding: row, check, value, limit, detail, severity."""
+    summary: Dict[str, Any]
+    """`clean`, `rows`, and per check its count and worst value."""
+
 def verify(
     machine: Machine,
     joints: npt.NDArray[np.float64],
@@ -194,7 +202,7 @@ def verify(
     feed: Optional[npt.NDArray[np.float64]] = None,
     thresholds: Optional[Dict[str, float]] = None,
     tool_length: Optional[float] = None,
-) -> Tuple[List[Dict[str, Any]], Dict[str, Any]]: ...
+) -> Verification: ...
 def workspace(
     machine: Machine,
     of: Literal["platform", "tool", "manufacturing"] = "platform",
