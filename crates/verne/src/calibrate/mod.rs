@@ -54,6 +54,11 @@ pub const FAR_ROW_MM: f64 = 25.0;
 /// the fit finds, one in 1e15 rows.
 pub const OUTLIER_SIGMAS: f64 = 8.0;
 
+/// The robust sigma of the outlier test is at least this fraction of the readings' stated noise:
+/// readings without noise (a plan's own) leave residuals of rounding, whose ratios mean
+/// nothing.
+pub const OUTLIER_FLOOR: f64 = 0.01;
+
 /// Pairs of parameters whose estimates are correlated beyond this are flagged: the readings
 /// tell little of their difference (or sum) apart.
 pub const CORRELATION_FLAG: f64 = 0.95;
@@ -449,12 +454,12 @@ pub fn calibrate(
     let robust = {
         let mut r: Vec<f64> = state.residuals.iter().map(|v| v.abs()).collect();
         r.sort_by(f64::total_cmp);
-        1.4826 * r[r.len() / 2] * noise.length_mm
+        (1.4826 * r[r.len() / 2]).max(OUTLIER_FLOOR) * noise.length_mm
     };
     let outliers: Vec<RowProblem> = rows
         .iter()
         .zip(&per_row)
-        .filter(|(_, r)| !(**r <= OUTLIER_SIGMAS * robust * 3f64.sqrt()) && robust > 0.0)
+        .filter(|(_, r)| !(**r <= OUTLIER_SIGMAS * robust * 3f64.sqrt()))
         .map(|(row, r)| RowProblem {
             line: row.line,
             message: format!(
