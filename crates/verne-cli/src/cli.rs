@@ -504,7 +504,7 @@ pub struct VerifyArgs {
 const CALIBRATE_HELP: &str = "\
 Examples:
   verne calibrate data/calibration/tracker.csv -o calibrated.toml --report ident.csv
-  verne calibrate data/calibration/ballbar.csv -m calibrated.toml -o table.toml
+  verne calibrate data/calibration/tracker.csv data/calibration/ballbar.csv -o calibrated.toml
   verne calibrate plan --device tracker --poses 30 -o poses.csv
 
 Measurements (CSV, one device per file; several files are fitted together, each instrument

@@ -10,7 +10,8 @@ mod common;
 use std::path::{Path, PathBuf};
 
 use common::{col, num, run, table};
-use nalgebra::{Rotation3, Vector3};
+use nalgebra::{DMatrix, DVector, Rotation3, Vector3};
+use verne::calibrate::Param;
 use verne::calibrate::model::{Device, Instrument, Measurement, Observed};
 use verne::calibrate::synthetic::{TYPICAL, joints, measure, perturbed};
 use verne::spec::Machine;
@@ -73,9 +74,111 @@ fn instrument() -> Instrument {
     }
 }
 
+/// A report's rows of one item: (key, value, sigma, detail); empty cells as NaN.
+fn report_rows(path: &Path, item: &str) -> Vec<(String, f64, f64, String)> {
+    let mut r = csv::Reader::from_path(path).unwrap();
+    let h = r.headers().unwrap().clone();
+    let at = |name: &str| h.iter().position(|c| c == name).unwrap();
+    let (i, k, v, sg, d) = (
+        at("item"),
+        at("key"),
+        at("value"),
+        at("sigma"),
+        at("detail"),
+    );
+    let cell = |s: &str| s.parse().unwrap_or(f64::NAN);
+    r.records()
+        .map(Result::unwrap)
+        .filter(|row| &row[i] == item)
+        .map(|row| {
+            (
+                row[k].to_string(),
+                cell(&row[v]),
+                cell(&row[sg]),
+                row[d].to_string(),
+            )
+        })
+        .collect()
+}
+
+/// The truth's parameters (shown units) moved along the combinations the report says the
+/// readings cannot see, until the held parameters are at their nominal values: the values a
+/// fit of those readings can recover.
+fn truth_in_gauge(truth: &Machine, report: &Path) -> Vec<(Param, f64)> {
+    let params = report_rows(report, "parameter");
+    let nominal = |p: Param| {
+        let (_, v, _, _) = params.iter().find(|(k, ..)| k == p.key()).unwrap();
+        *v
+    };
+    // Each held parameter's combination: "...; moves KEY +C, KEY +C".
+    let held: Vec<(Param, Vec<(Param, f64)>)> = report_rows(report, "combination")
+        .into_iter()
+        .map(|(key, _, _, detail)| {
+            let moves = detail.rsplit_once("; moves ").unwrap().1;
+            let combination = moves
+                .split(", ")
+                .map(|m| {
+                    let (k, c) = m.rsplit_once(' ').unwrap();
+                    (Param::from_key(k).unwrap(), num(c))
+                })
+                .collect();
+            (Param::from_key(&key).unwrap(), combination)
+        })
+        .collect();
+    let coef = |k: usize, p: Param| {
+        held[k]
+            .1
+            .iter()
+            .find(|(q, _)| *q == p)
+            .map_or(0.0, |(_, c)| *c)
+    };
+    let n = held.len();
+    let a = DMatrix::from_fn(n, n, |i, k| coef(k, held[i].0));
+    let b = DVector::from_fn(n, |i, _| {
+        let p = held[i].0;
+        nominal(p) - p.shown(p.value(truth))
+    });
+    let c = a.lu().solve(&b).expect("independent combinations");
+    params
+        .iter()
+        .map(|(key, ..)| {
+            let p = Param::from_key(key).unwrap();
+            let moved: f64 = (0..n).map(|k| c[k] * coef(k, p)).sum();
+            (p, p.shown(p.value(truth)) + moved)
+        })
+        .collect()
+}
+
+/// Every identified parameter of a report against the truth in the fit's gauge: within 3
+/// sigma. The largest |error| / sigma.
+fn within_three_sigma(truth: &Machine, report: &Path) -> f64 {
+    let gauge = truth_in_gauge(truth, report);
+    let mut worst = 0.0f64;
+    for (key, value, sigma, detail) in report_rows(report, "parameter") {
+        if detail != "identified" {
+            continue;
+        }
+        let p = Param::from_key(&key).unwrap();
+        let (_, t) = gauge.iter().find(|(q, _)| *q == p).unwrap();
+        let z = (value - t).abs() / sigma;
+        assert!(z <= 3.0, "{key}: {value} vs truth {t}, 1 sigma {sigma}");
+        worst = worst.max(z);
+    }
+    worst
+}
+
+/// The shipped tracker data: the four combinations a tracker cannot see named, the other
+/// parameters recovered within 3 sigma of data/calibration/truth.toml (brought to the fit's
+/// gauge), a machine file `machine check` accepts; the tracker and the ballbar together
+/// determine the table too, also within 3 sigma.
 #[test]
-fn the_shipped_tracker_data_calibrates() {
+fn the_shipped_data_calibrate_to_their_truth() {
     let dir = scratch("shipped");
+    let truth = Machine::from_toml_str(
+        &std::fs::read_to_string(format!("{}/data/calibration/truth.toml", common::ROOT)).unwrap(),
+        "truth.toml",
+    )
+    .unwrap();
     let out = dir.join("calibrated.toml");
     let report = dir.join("ident.csv");
     let r = run(
@@ -100,23 +203,49 @@ fn the_shipped_tracker_data_calibrates() {
     ] {
         assert!(text.contains(words), "{words}:\n{text}");
     }
+    assert_eq!(report_rows(&report, "combination").len(), 4);
+    within_three_sigma(&truth, &report);
     // A machine file on the embedded machine that `machine check` accepts.
     let file = std::fs::read_to_string(&out).unwrap();
     assert!(file.contains("base = \"verne\""), "{file}");
     let check = run(&["machine", "check", s(&out)], None);
     assert_eq!(check.status.code(), Some(0), "{}", stderr(&check));
-    // The report: every parameter, the instrument, the residuals.
-    let (h, rows) = table(&std::fs::read_to_string(&report).unwrap());
-    let (item, key, value) = (col(&h, "item"), col(&h, "key"), col(&h, "value"));
-    let find = |i: &str, k: &str| {
-        rows.iter()
-            .find(|r| r[item] == i && r[key] == k)
-            .unwrap_or_else(|| panic!("{i} {k}"))
+    // The residuals: the stated noise (10 um) after, the hold-out within 10 % of it.
+    let residual = |k: &str| {
+        report_rows(&report, "residual")
+            .into_iter()
+            .find(|r| r.0 == k)
+            .unwrap()
+            .1
     };
-    assert!(num(&find("residual", "rms_after")[value]) < 0.012);
-    assert!(num(&find("residual", "rms_before")[value]) > 0.1);
-    assert_eq!(rows.iter().filter(|r| r[item] == "parameter").count(), 15);
-    assert_eq!(rows.iter().filter(|r| r[item] == "instrument").count(), 6);
+    assert!((residual("rms_after") / NOISE_MM - 1.0).abs() < 0.1);
+    assert!((residual("rms_holdout") / NOISE_MM - 1.0).abs() < 0.1);
+    assert!(residual("rms_before") > 10.0 * NOISE_MM);
+    assert_eq!(report_rows(&report, "parameter").len(), 15);
+    assert_eq!(report_rows(&report, "instrument").len(), 6);
+    // Both files: the table's parameters too.
+    let r = run(
+        &[
+            "calibrate",
+            "data/calibration/tracker.csv",
+            "data/calibration/ballbar.csv",
+            "-o",
+            s(&out),
+            "--report",
+            s(&report),
+        ],
+        None,
+    );
+    assert_eq!(r.status.code(), Some(0), "{}", stderr(&r));
+    let identified: Vec<String> = report_rows(&report, "parameter")
+        .into_iter()
+        .filter(|r| r.3 == "identified")
+        .map(|r| r.0)
+        .collect();
+    for key in ["table.d_a", "table.y_t", "zeros.theta1", "module.D2"] {
+        assert!(identified.iter().any(|k| k == key), "{key}: {identified:?}");
+    }
+    within_three_sigma(&truth, &report);
 }
 
 /// A synthetic machine read by the module alone (platform points, 10 um): the calibrated file
@@ -238,18 +367,25 @@ fn bad_input_is_refused_with_its_line() {
     assert!(err.contains("18 readings for 21 unknowns"), "{err}");
     // A NaN and an empty cell: the file, line and column.
     let mut nan = lines.clone();
-    let replaced = nan[5].replacen(',', ",NaN,", 1);
-    let replaced = replaced
-        .splitn(3, ',')
-        .enumerate()
-        .filter(|(k, _)| *k != 1)
-        .map(|(_, v)| v)
-        .collect::<Vec<_>>()
-        .join(",");
+    let replaced = {
+        let mut c: Vec<&str> = nan[5].split(',').collect();
+        c[1] = "NaN";
+        c.join(",")
+    };
     nan[5] = &replaced;
     let (code, err) = attempt("nan.csv", &(nan.join("\n") + "\n"), &[]);
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("nan.csv:6: column rho2"), "{err}");
+    let mut empty = lines.clone();
+    let blank = {
+        let mut c: Vec<&str> = empty[7].split(',').collect();
+        c[5] = "";
+        c.join(",")
+    };
+    empty[7] = &blank;
+    let (code, err) = attempt("empty.csv", &(empty.join("\n") + "\n"), &[]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("empty.csv:8: column x"), "{err}");
     // A reading 40 mm off: far from any pose, its line; exit 1.
     let mut far = lines.clone();
     let cells: Vec<String> = far[9].split(',').map(str::to_string).collect();

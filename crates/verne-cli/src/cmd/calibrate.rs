@@ -570,6 +570,24 @@ fn read_measurements(
             ));
         }
     };
+    // Every column is known: a misspelt one is not silently left out.
+    let known = [
+        "rho1", "rho2", "rho3", "theta1", "theta2", "i", "j", "k", "id",
+    ];
+    for (k, h) in src.headers().iter().enumerate() {
+        let h = String::from_utf8_lossy(h).to_ascii_lowercase();
+        if !known.contains(&h.as_str()) && !cols.contains(&h.as_str()) {
+            return Err(VerneError::input(
+                &name,
+                Some(1),
+                Some(&src.header_name(k)),
+                format!(
+                    "unknown column; expected rho1,rho2,rho3, theta1,theta2, id and a device's readings ({})",
+                    cols.join(",")
+                ),
+            ));
+        }
+    }
     let reading: Vec<usize> = cols.iter().map(|c| src.column(c).unwrap_or(0)).collect();
     let theta = match (src.column("theta1"), src.column("theta2")) {
         (Some(a), Some(b)) => Some([a, b]),
@@ -599,24 +617,6 @@ fn read_measurements(
             ));
         }
     };
-    // Every column is known: a misspelt one is not silently left out.
-    let known = [
-        "rho1", "rho2", "rho3", "theta1", "theta2", "i", "j", "k", "id",
-    ];
-    for (k, h) in src.headers().iter().enumerate() {
-        let h = String::from_utf8_lossy(h).to_ascii_lowercase();
-        if !known.contains(&h.as_str()) && !cols.contains(&h.as_str()) {
-            return Err(VerneError::input(
-                &name,
-                Some(1),
-                Some(&src.header_name(k)),
-                format!(
-                    "unknown column; expected rho1,rho2,rho3, theta1,theta2, id and a device's readings ({})",
-                    cols.join(",")
-                ),
-            ));
-        }
-    }
     let mut row = TableRow::default();
     let mut out = Vec::new();
     let angle = |v: f64| if radians { v } else { v.to_radians() };
