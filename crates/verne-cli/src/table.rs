@@ -20,6 +20,9 @@ pub struct CsvSource {
     headers: ByteRecord,
 }
 
+/// Rows of numbers, each with its line: the command line's, or another reader's.
+pub type NumberRows = Box<dyn Iterator<Item = Result<(u64, Vec<f64>), VerneError>> + Send>;
+
 /// One row of a table as read: a CSV record's cells, or the numbers of a command-line row.
 #[derive(Debug, Default, Clone)]
 pub struct TableRow {
@@ -40,9 +43,8 @@ enum Records {
         raw: ByteRecord,
     },
     Numbers {
-        rows: std::vec::IntoIter<Vec<f64>>,
-        /// The number of rows read so far.
-        read: u64,
+        /// Each row's line and numbers.
+        rows: NumberRows,
     },
 }
 
@@ -108,11 +110,18 @@ impl CsvSource {
 
     /// Rows of numbers given on the command line, under the column names `header`.
     pub fn from_numbers(header: &[&str], rows: Vec<Vec<f64>>, name: &str) -> CsvSource {
+        let rows = rows
+            .into_iter()
+            .enumerate()
+            .map(|(k, r)| Ok((k as u64 + 1, r)));
+        CsvSource::from_number_rows(header, Box::new(rows), name)
+    }
+
+    /// Rows of numbers from another reader (a G-code joint program's joints), each with its
+    /// line, under the column names `header`.
+    pub fn from_number_rows(header: &[&str], rows: NumberRows, name: &str) -> CsvSource {
         CsvSource {
-            records: Records::Numbers {
-                rows: rows.into_iter(),
-                read: 0,
-            },
+            records: Records::Numbers { rows },
             name: name.to_string(),
             headers: ByteRecord::from(header.to_vec()),
         }
@@ -201,14 +210,14 @@ impl CsvSource {
     /// surrounding ASCII white space removed.
     pub fn read_row(&mut self, row: &mut TableRow) -> Result<bool, VerneError> {
         match &mut self.records {
-            Records::Numbers { rows, read } => {
-                let Some(numbers) = rows.next() else {
+            Records::Numbers { rows } => {
+                let Some(next) = rows.next() else {
                     return Ok(false);
                 };
-                *read += 1;
+                let (line, numbers) = next?;
                 row.record.clear();
                 row.numbers = numbers;
-                row.line = *read;
+                row.line = line;
                 Ok(true)
             }
             Records::Text { .. } => {
@@ -396,7 +405,7 @@ impl Sink {
     }
 
     /// Passes everything written through `wrap` (a writer that turns the CSV into another
-    /// format, such as [`crate::post::GcodePost`]); call before the first write.
+    /// format, such as [`crate::follow::write::GcodeProgram`]); call before the first write.
     pub fn wrap(&mut self, wrap: impl FnOnce(Box<dyn Write + Send>) -> Box<dyn Write + Send>) {
         let inner = std::mem::replace(&mut self.writer, Box::new(io::sink()));
         self.writer = wrap(inner);
@@ -612,6 +621,56 @@ fn check_output_target(path: &Path) -> io::Result<()> {
         return Err(io::Error::other(
             "is an input of this run: refusing to overwrite it with the output (name another file)",
         ));
+    }
+    Ok(())
+}
+
+/// What an output is, to tell two of one run apart: standard output, an existing file (device
+/// and inode: the same file under any name), or a file to be (its folder resolved).
+#[derive(Debug, PartialEq)]
+enum OutputIdentity {
+    Stdout,
+    Inode(u64, u64),
+    Path(PathBuf),
+}
+
+fn output_identity(path: &Path) -> OutputIdentity {
+    use std::os::unix::fs::MetadataExt;
+    if path.as_os_str() == "-" || path == Path::new("/dev/stdout") {
+        return OutputIdentity::Stdout;
+    }
+    if let Ok(m) = std::fs::metadata(path) {
+        return OutputIdentity::Inode(m.dev(), m.ino());
+    }
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let dir = std::fs::canonicalize(dir).unwrap_or_else(|_| dir.to_path_buf());
+    OutputIdentity::Path(dir.join(path.file_name().unwrap_or_default()))
+}
+
+/// Refuses, before any work, two outputs of one run that are the same file (the same path once
+/// resolved, or the same inode) or that both write standard output: one would replace or mix
+/// with the other. `outputs` are (option, path) pairs.
+pub fn check_distinct_outputs(outputs: &[(&str, &Path)]) -> Result<(), VerneError> {
+    let ids: Vec<OutputIdentity> = outputs.iter().map(|(_, p)| output_identity(p)).collect();
+    for i in 0..outputs.len() {
+        for j in i + 1..outputs.len() {
+            if ids[i] != ids[j] {
+                continue;
+            }
+            let ((a, pa), (b, pb)) = (outputs[i], outputs[j]);
+            return Err(VerneError::Usage(if ids[i] == OutputIdentity::Stdout {
+                format!("{a} and {b} both write standard output: give one of them a file")
+            } else {
+                format!(
+                    "{a} {} and {b} {} are the same file: each output of a run needs a file of its own",
+                    pa.display(),
+                    pb.display()
+                )
+            }));
+        }
     }
     Ok(())
 }
@@ -958,6 +1017,35 @@ pub(crate) mod tests {
         fn flush(&mut self) -> io::Result<()> {
             Ok(())
         }
+    }
+
+    #[test]
+    fn two_outputs_of_one_run_are_different_files() {
+        let dir = std::env::temp_dir().join(format!("verne-outputs-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let a = dir.join("a.csv");
+        std::fs::write(&a, "x").unwrap();
+        let link = dir.join("b.csv");
+        let _ = std::fs::remove_file(&link);
+        std::fs::hard_link(&a, &link).unwrap();
+        let dotted = dir.join(".").join("c.csv");
+        let plain = dir.join("c.csv");
+        let same = [
+            (a.as_path(), a.as_path()),
+            (a.as_path(), link.as_path()),
+            (dotted.as_path(), plain.as_path()),
+            (Path::new("-"), Path::new("/dev/stdout")),
+        ];
+        for (p, q) in same {
+            assert!(
+                check_distinct_outputs(&[("-o", p), ("--plot", q)]).is_err(),
+                "{p:?} {q:?}"
+            );
+        }
+        assert!(
+            check_distinct_outputs(&[("-o", a.as_path()), ("--plot", plain.as_path())]).is_ok()
+        );
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]

@@ -1,8 +1,8 @@
-//! verne: exact kinematics of the VERNE hybrid machine tool and of planar glider mechanisms.
+#![doc = include_str!("../README.md")]
 //!
-//! This crate computes; the `verne` command (crate `verne-cli`) talks. Nothing here prints,
-//! exits, reads a CSV or knows the command line: results are typed values. The folders follow
-//! the concepts (ARCHITECTURE.md):
+//! ## The modules
+//!
+//! Results are typed values. The folders follow the concepts (ARCHITECTURE.md):
 //!
 //! - [`spec`]: the machine's parameters and its machine file (TOML or key,value CSV);
 //! - [`parallel_module`]: the 3-DOF parallel module of IFToMM 2007 (equations (3)-(6), inverse
@@ -28,6 +28,7 @@ pub mod certificate;
 pub mod details;
 pub mod error;
 pub mod glider;
+pub mod kinematics;
 pub mod machine;
 pub mod math;
 mod par;
@@ -39,3 +40,11 @@ pub mod stream;
 pub mod tolerance;
 pub mod verify;
 pub mod workspace;
+
+pub use kinematics::{Follower, Joints};
+pub use machine::orientation::{ToolAngles, ToolOrientation};
+pub use machine::{
+    MachineFkMode, MachineFkModes, MachineIkBranch, PathCandidates, PathError, PathRow, ToolPose,
+};
+pub use nalgebra::Vector3;
+pub use spec::Machine;

@@ -87,6 +87,9 @@ pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
         ));
     }
     crate::arg_values::spatial(&args.pose, "--pose", "XP,YP,ZP").map_err(VerneError::Usage)?;
+    if let (Some(o), Some(r)) = (&args.output, &args.schedule_report) {
+        crate::table::check_distinct_outputs(&[("-o", o), ("--schedule-report", r)])?;
+    }
     if !args.pose.is_empty() {
         let source = inline_source(
             &["xp", "yp", "zp"],

@@ -102,6 +102,11 @@ fn read_machine(path: Option<&Path>) -> Result<Machine, VerneError> {
             let dir = p.parent().map(Path::to_path_buf).unwrap_or_default();
             let resolve = |base: &str| -> Result<(String, String), String> {
                 let path = dir.join(base);
+                if !path.exists() && verne::glider::GliderSpec::preset(base).is_some() {
+                    return Err(format!(
+                        "`{base}` is a glider preset, not a VERNE machine: a VERNE machine file's base is `verne` or the path of another VERNE machine file"
+                    ));
+                }
                 let shown = path.display().to_string();
                 let bytes = crate::table::read_input_file(&path)
                     .map_err(|e| format!("base {shown}: {e}"))?;

@@ -1,5 +1,5 @@
 //! `verne ik` on a toolpath: typed rows from a reader ([`crate::toolpath`]) to a writer
-//! ([`write`]), through the machine's inverse kinematics along the path. Rows go through in
+//! ([`mod@write`]), through the machine's inverse kinematics along the path. Rows go through in
 //! batches on the core's row engine ([`verne::stream::run_batches`]): while one batch is read,
 //! the one before is solved (every branch of each row in parallel, then the branch chosen in
 //! order, nearest the previous row) and the one before that is written.

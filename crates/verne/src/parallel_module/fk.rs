@@ -678,8 +678,8 @@ mod tests {
     /// Sliders whose modes are simple, well-separated roots of F are proved in double
     /// precision alone (no interval left ambiguous for the factors to resolve): Table III of
     /// IFToMM 2007 and the working joints of the two poses off y = 0 above. The pose on y = 0
-    /// has two modes 1.3e-4 rad apart in alpha (the reference document,
-    /// shared/reference/verne-geometry.md): that pair needs the factors.
+    /// has two modes 1.3e-4 rad apart in alpha (docs/reference-results.md): that pair needs the
+    /// factors.
     #[test]
     fn simple_roots_are_proved_in_double_precision() {
         let (m, poses) = poses_and_sliders();

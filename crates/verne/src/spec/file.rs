@@ -679,6 +679,11 @@ impl TomlLines {
             if let Some(rest) = t.strip_prefix('[') {
                 // `[module] # a comment`: the name ends at the first `]`.
                 current = rest.split(']').next().unwrap_or("").trim().to_string();
+                // A nested table `[verify.sub]` is the key `sub` of `[verify]`, at this line.
+                if let Some((outer, inner)) = current.rsplit_once('.') {
+                    map.entry((outer.trim().to_string(), inner.trim().to_string()))
+                        .or_insert(i + 1);
+                }
                 continue;
             }
             if t.contains('=') {
