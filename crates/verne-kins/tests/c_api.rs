@@ -253,9 +253,9 @@ fn the_machine_files_offsets_are_applied() {
     offsets.table.y_t = 0.25;
     let mut hand = verne::spec::Machine::default_verne();
     hand.table.y_t = 0.25;
-    for k in 0..3 {
-        hand.limits.rho_min[k] += rho_zero[k];
-        hand.limits.rho_max[k] += rho_zero[k];
+    for (k, z) in rho_zero.iter().enumerate() {
+        hand.limits.rho_min[k] += z;
+        hand.limits.rho_max[k] += z;
     }
     hand.limits.theta1_min += theta_zero_deg[0].to_radians();
     hand.limits.theta1_max += theta_zero_deg[0].to_radians();

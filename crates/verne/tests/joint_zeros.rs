@@ -42,9 +42,9 @@ fn with_zeros() -> Machine {
 fn by_hand() -> Machine {
     let mut m = Machine::default_verne();
     m.table.y_t = Y_T;
-    for k in 0..3 {
-        m.limits.rho_min[k] += RHO_ZERO[k];
-        m.limits.rho_max[k] += RHO_ZERO[k];
+    for (k, z) in RHO_ZERO.iter().enumerate() {
+        m.limits.rho_min[k] += z;
+        m.limits.rho_max[k] += z;
     }
     m.limits.theta1_min += THETA_ZERO_DEG[0].to_radians();
     m.limits.theta1_max += THETA_ZERO_DEG[0].to_radians();

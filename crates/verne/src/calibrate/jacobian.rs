@@ -20,7 +20,7 @@
 //!
 //! and d(L_i^2)/dL_i = 2 L_i on the rods of leg i. The readings then follow by the chain rule
 //! ([`super::model`]); the instrument's rotation is differentiated on the right,
-//! d(R exp([r]) x)/dr = -R [x]x at r = 0.
+//! d(R exp(\[r\]) x)/dr = -R \[x\]x at r = 0.
 
 use nalgebra::{DMatrix, Matrix3, Matrix4, RowVector4, Vector3, Vector4};
 

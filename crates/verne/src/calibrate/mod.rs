@@ -11,7 +11,7 @@
 //!   (3)-(6);
 //! - [`identifiability`]: the rank of the scaled Jacobian and the combinations the readings
 //!   cannot see;
-//! - [`fit`]: Levenberg-Marquardt, sigmas and correlations;
+//! - [`fit`](mod@fit): Levenberg-Marquardt, sigmas and correlations;
 //! - [`plan`]: D-optimal poses for a device (exchange algorithm) with the predicted sigmas;
 //! - [`synthetic`]: perturbed machines and what instruments read of them, for tests and
 //!   examples.
@@ -387,7 +387,7 @@ pub fn calibrate(
     let far: Vec<RowProblem> = rows
         .iter()
         .zip(row_residuals(rows, &start.residuals, noise))
-        .filter(|(_, r)| !(*r <= FAR_ROW_MM))
+        .filter(|(_, r)| r.is_nan() || *r > FAR_ROW_MM)
         .map(|(row, r)| RowProblem {
             line: row.line,
             message: format!(
@@ -435,7 +435,7 @@ pub fn calibrate(
             .iter()
             .enumerate()
             .map(|(c, &p)| (c, p, cov[(c, c)].sqrt() / options.prior(p)))
-            .filter(|(_, _, r)| !(*r <= 1.0))
+            .filter(|(_, _, r)| r.is_nan() || *r > 1.0)
             .max_by(|a, b| a.2.total_cmp(&b.2));
         match worst {
             Some((c, p, _)) => {
@@ -459,7 +459,7 @@ pub fn calibrate(
     let outliers: Vec<RowProblem> = rows
         .iter()
         .zip(&per_row)
-        .filter(|(_, r)| !(**r <= OUTLIER_SIGMAS * robust * 3f64.sqrt()))
+        .filter(|(_, r)| r.is_nan() || **r > OUTLIER_SIGMAS * robust * 3f64.sqrt())
         .map(|(row, r)| RowProblem {
             line: row.line,
             message: format!(

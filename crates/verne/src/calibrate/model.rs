@@ -108,7 +108,7 @@ impl Device {
 /// A nuisance parameter: where the instrument is (its frame, or the ballbar's table ball).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Nuisance {
-    /// Rotation of the instrument frame about its x, y, z (rad; R = R0 exp([r]), r small).
+    /// Rotation of the instrument frame about its x, y, z (rad; R = R0 exp(\[r\]), r small).
     FrameRx,
     FrameRy,
     FrameRz,
@@ -293,7 +293,7 @@ impl Default for Instrument {
 
 impl Instrument {
     /// The instrument moved by `delta` of each nuisance parameter (rotations composed on the
-    /// right: R exp([r])).
+    /// right: R exp(\[r\])).
     pub fn moved(&self, which: &[Nuisance], delta: &[f64]) -> Instrument {
         let mut out = *self;
         let mut r = Vector3::zeros();

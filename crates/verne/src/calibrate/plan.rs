@@ -428,46 +428,43 @@ pub fn plan(m: &Machine, options: &PlanOptions) -> Result<Plan, PlanError> {
         .collect();
     let undetermined = sigmas
         .iter()
-        .filter(|(p, s)| !(*s <= p.default_prior()))
+        .filter(|(p, s)| s.is_nan() || *s > p.default_prior())
         .copied()
         .collect();
     // The tool tip's sigma over the candidates: its derivative in the machine's parameters
     // (the instrument's rows of a tracker's reading at R = I, t = 0 are the tip itself).
-    let tip_rows = {
-        let tip_j = jacobian(
-            m,
-            &[Instrument::default()],
-            &rows
-                .iter()
-                .map(|r| Measurement {
-                    observed: Observed::Tip {
-                        tip: Vector3::zeros(),
-                        axis: None,
-                    },
-                    ..*r
-                })
-                .collect::<Vec<_>>(),
-            &poses,
-            &inverses,
-            &free,
-            &[],
-            &Noise {
-                length_mm: 1.0,
-                axis_rad: 1.0,
-            },
-        );
-        tip_j
-    };
+    let tip_rows = jacobian(
+        m,
+        &[Instrument::default()],
+        &rows
+            .iter()
+            .map(|r| Measurement {
+                observed: Observed::Tip {
+                    tip: Vector3::zeros(),
+                    axis: None,
+                },
+                ..*r
+            })
+            .collect::<Vec<_>>(),
+        &poses,
+        &inverses,
+        &free,
+        &[],
+        &Noise {
+            length_mm: 1.0,
+            axis_rad: 1.0,
+        },
+    );
     let cmm = cov.view((0, 0), (free.len(), free.len())).into_owned();
     let (mut sum, mut max) = (0.0, 0.0f64);
     for k in 0..rows.len() {
         let t = tip_rows.rows(3 * k, 3);
-        let var = (&t * &cmm * t.transpose()).trace();
+        let var = (t * &cmm * t.transpose()).trace();
         sum += var;
         max = max.max(var.sqrt());
     }
     let worst_mm = worst_length(&cov, &free);
-    let mut u = lcg(options.seed ^ 0x5eed_0f_5e75);
+    let mut u = lcg(options.seed ^ 0x005e_ed0f_5e75);
     let mut random: Vec<f64> = (0..options.random_sets)
         .map(|_| {
             let mut set: Vec<usize> = Vec::with_capacity(options.poses);

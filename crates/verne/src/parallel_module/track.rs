@@ -35,7 +35,7 @@ const CERTIFIED_FRACTION: f64 = 0.25;
 
 /// The assembly mode nearest `from` for the sliders `rho` (joints) of the geometry `g`, when it
 /// is certified to be: Newton on eqs. (3)-(6) from `from` converges to q*, and q* moved less
-/// than [`CERTIFIED_FRACTION`] of the isolation radius 2 / (beta L) from `from` (the lemma of
+/// than `CERTIFIED_FRACTION` (1/4) of the isolation radius 2 / (beta L) from `from` (the lemma of
 /// the module documentation, the bounds of [`FkTracker`]), so that no other solution of the
 /// equations is nearer `from`. Also returns A^-1 at q* (A = d(residuals)/d(pose)). For a
 /// caller whose geometry changes between calls (a calibration's steps) as the sliders do along a

@@ -102,9 +102,9 @@ impl Machine {
         }
         let (rz, tz) = (self.module.rho_zero, self.table.theta_zero);
         let mut limits = self.limits;
-        for k in 0..3 {
-            limits.rho_min[k] += rz[k];
-            limits.rho_max[k] += rz[k];
+        for ((min, max), z) in limits.rho_min.iter_mut().zip(&mut limits.rho_max).zip(rz) {
+            *min += z;
+            *max += z;
         }
         limits.theta1_min += tz[0];
         limits.theta1_max += tz[0];
