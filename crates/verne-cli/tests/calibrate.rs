@@ -421,6 +421,29 @@ fn bad_input_is_refused_with_its_line() {
     assert!(err.contains("col.csv:1: column theta"), "{err}");
     let (code, err) = attempt("mix.csv", &text.replacen(",z\n", ",z,height\n", 1), &[]);
     assert_eq!(code, Some(2), "{err}");
+    // The output over an input or over the report.
+    let (code, err) = attempt("same.csv", &text, &["--report", s(&out)]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("the same file"), "{err}");
+    let nominal_file = dir.join("nominal.toml");
+    std::fs::write(&nominal_file, "base = \"verne\"\n").unwrap();
+    let r = run(
+        &[
+            "calibrate",
+            s(&good),
+            "-m",
+            s(&nominal_file),
+            "-o",
+            s(&nominal_file),
+        ],
+        None,
+    );
+    assert_eq!(r.status.code(), Some(2), "{}", stderr(&r));
+    assert!(stderr(&r).contains("is the input -m"), "{}", stderr(&r));
+    assert_eq!(
+        std::fs::read_to_string(&nominal_file).unwrap(),
+        "base = \"verne\"\n"
+    );
     // An unknown key to free.
     let (code, err) = attempt("good2.csv", &text, &["--free", "module.L9"]);
     assert_eq!(code, Some(2), "{err}");

@@ -105,6 +105,24 @@ pub fn run(args: &CalibrateArgs) -> Result<u8, VerneError> {
         return run_plan(p);
     }
     let machine_path = args.common.machine.as_deref();
+    let output = args.output.as_deref().expect("required by clap");
+    if let Some(r) = &args.report {
+        crate::table::check_distinct_outputs(&[("-o", output), ("--report", r)])?;
+    }
+    // The calibrated file names the nominal as its base and must not replace it or a reading.
+    let inputs = machine_path
+        .map(|m| ("-m", m))
+        .into_iter()
+        .chain(args.measurements.iter().map(|p| ("MEAS.csv", p.as_path())));
+    for (option, input) in inputs {
+        crate::table::check_distinct_outputs(&[("-o", output), (option, input)]).map_err(|_| {
+            VerneError::Usage(format!(
+                "-o {} is the input {option} {}: the calibrated file needs a file of its own",
+                output.display(),
+                input.display()
+            ))
+        })?;
+    }
     let nominal = load_machine(machine_path)?;
     let options = options_of(&args.fit)?;
     let radians = args.common.radians;
@@ -117,7 +135,6 @@ pub fn run(args: &CalibrateArgs) -> Result<u8, VerneError> {
         .iter()
         .map(|p| p.display().to_string())
         .collect();
-    let output = args.output.as_deref().expect("required by clap");
     let started = std::time::Instant::now();
     let result = calibrate(&nominal, &rows, &options);
     let seconds = started.elapsed().as_secs_f64();
@@ -691,6 +708,9 @@ fn read_measurements(
 
 /// `verne calibrate plan`.
 fn run_plan(args: &CalibratePlanArgs) -> Result<u8, VerneError> {
+    if let (Some(o), Some(r)) = (&args.output, &args.report) {
+        crate::table::check_distinct_outputs(&[("-o", o), ("--report", r)])?;
+    }
     let machine = load_machine(args.common.machine.as_deref())?;
     let device = match args.device {
         CalibrationDevice::Tracker => Device::Tracker,
