@@ -108,6 +108,7 @@ pub fn run() -> ExitCode {
         cli::Command::Workspace(a) => cmd::workspace::run(a),
         cli::Command::Selftest(a) => cmd::selftest::run(a),
         cli::Command::Verify(a) => cmd::verify::run(a),
+        cli::Command::Calibrate(a) => cmd::calibrate::run(a),
         cli::Command::Completions { shell } => cmd::shell::completions(*shell),
         cli::Command::Manpage => cmd::shell::manpage(),
     };

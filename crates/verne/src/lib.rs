@@ -10,6 +10,8 @@
 //! - [`machine`]: the whole machine of AIM 2007 (module plus tilting table, tool orientation,
 //!   a toolpath followed on one branch);
 //! - [`workspace`], [`verify`], [`selftest`]: analyses built on them;
+//! - [`calibrate`]: the machine file's parameters identified from measurements of the real
+//!   machine, what the measurements cannot determine, and where to measure;
 //! - [`post`]: joint programs a machine can run (linearization within tolerances, block times
 //!   within the drives' limits);
 //! - [`glider`]: the planar glider mechanisms of the comparative study (Wenger 2001);
@@ -21,6 +23,7 @@
 //! The `parallel` feature (on by default) runs grids and batches on rayon's threads; without it
 //! the same computations run in order, with the same results.
 
+pub mod calibrate;
 pub mod certificate;
 pub mod details;
 pub mod error;

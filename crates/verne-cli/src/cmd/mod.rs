@@ -1,6 +1,7 @@
 //! One file per subcommand; this file holds what they share: loading the machine, opening the
 //! input and output, and turning a run's summary into an exit code.
 
+pub mod calibrate;
 pub mod design;
 pub mod fk;
 pub mod glider;

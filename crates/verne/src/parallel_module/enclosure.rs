@@ -51,11 +51,21 @@ fn rod_vectors(g: &ModuleGeometry, x: &[Iv; 4], rho: &[Iv; 3]) -> [[Iv; 3]; 4] {
 fn rod_vectors_sc(g: &ModuleGeometry, x: &[Iv; 4], rho: &[Iv; 3], s: Iv, c: Iv) -> [[Iv; 3]; 4] {
     let k = Iv::point;
     let (r1, rs1, r2, r4) = (k(g.r_big1), k(g.r_small1), k(g.r_big2), k(g.r4));
+    // The joints' sliders plus their zero offsets are the equations' (equations::rod_vectors);
+    // a zero offset of 0 leaves the interval as it is.
+    let eq = |i: usize| {
+        if g.rho_zero[i] == 0.0 {
+            rho[i]
+        } else {
+            rho[i] + k(g.rho_zero[i])
+        }
+    };
+    let (q1, q2, q3) = (eq(0), eq(1), eq(2));
     [
-        [x[0] + k(g.dx1), x[1] + r1 * c - rs1, x[2] + r1 * s - rho[0]],
-        [x[0] + k(g.dx1), x[1] - r1 * c + rs1, x[2] - r1 * s - rho[0]],
-        [x[0] + k(g.dx2), x[1] - r2 * c + r4, x[2] - r2 * s - rho[1]],
-        [x[0] + k(g.dx2), x[1] + r2 * c - r4, x[2] + r2 * s - rho[2]],
+        [x[0] + k(g.dx1), x[1] + r1 * c - rs1, x[2] + r1 * s - q1],
+        [x[0] + k(g.dx1), x[1] - r1 * c + rs1, x[2] - r1 * s - q1],
+        [x[0] + k(g.dx2), x[1] - r2 * c + r4, x[2] - r2 * s - q2],
+        [x[0] + k(g.dx2), x[1] + r2 * c - r4, x[2] + r2 * s - q3],
     ]
 }
 
