@@ -21,7 +21,8 @@ use crate::cli::{
     CalibrateArgs, CalibrateCommand, CalibrateFitArgs, CalibratePlanArgs, CalibrationDevice,
 };
 use crate::error::VerneError;
-use crate::table::{CellError, CsvSource, Sink, TableRow, format_number, parse_number};
+use crate::files::Sink;
+use crate::table::{CellError, CsvSource, TableRow, format_number, parse_number};
 
 /// Parses a prior bound `KEY=BOUND` (a machine-file key a calibration can move, a positive
 /// bound in mm or degrees).
@@ -107,7 +108,7 @@ pub fn run(args: &CalibrateArgs) -> Result<u8, VerneError> {
     let machine_path = args.common.machine.as_deref();
     let output = args.output.as_deref().expect("required by clap");
     if let Some(r) = &args.report {
-        crate::table::check_distinct_outputs(&[("-o", output), ("--report", r)])?;
+        crate::files::check_distinct_outputs(&[("-o", output), ("--report", r)])?;
     }
     // The calibrated file names the nominal as its base and must not replace it or a reading.
     let inputs = machine_path
@@ -115,7 +116,7 @@ pub fn run(args: &CalibrateArgs) -> Result<u8, VerneError> {
         .into_iter()
         .chain(args.measurements.iter().map(|p| ("MEAS.csv", p.as_path())));
     for (option, input) in inputs {
-        crate::table::check_distinct_outputs(&[("-o", output), (option, input)]).map_err(|_| {
+        crate::files::check_distinct_outputs(&[("-o", output), (option, input)]).map_err(|_| {
             VerneError::Usage(format!(
                 "-o {} is the input {option} {}: the calibrated file needs a file of its own",
                 output.display(),
@@ -159,7 +160,7 @@ pub fn run(args: &CalibrateArgs) -> Result<u8, VerneError> {
     let text = c.machine_file(&base, &header);
     // The file as written must read back as a valid machine over its base.
     check_written(&text, machine_path, output)?;
-    crate::table::write_output(output, text.as_bytes())
+    crate::files::write_output(output, text.as_bytes())
         .map_err(|e| VerneError::io(&output.display().to_string(), e))?;
     if let Some(report) = &args.report {
         write_report(report, &c, args.common.precision.map(usize::from))?;
@@ -709,7 +710,7 @@ fn read_measurements(
 /// `verne calibrate plan`.
 fn run_plan(args: &CalibratePlanArgs) -> Result<u8, VerneError> {
     if let (Some(o), Some(r)) = (&args.output, &args.report) {
-        crate::table::check_distinct_outputs(&[("-o", o), ("--report", r)])?;
+        crate::files::check_distinct_outputs(&[("-o", o), ("--report", r)])?;
     }
     let machine = load_machine(args.common.machine.as_deref())?;
     let device = match args.device {
