@@ -9,9 +9,6 @@ PY="$(command -v python3)"
 [ -x "$VENV/bin/python" ] || "$PY" -m venv "$VENV"
 "$VENV/bin/python" -m pip install -q --upgrade pip >/dev/null
 "$VENV/bin/python" -m pip install -q "maturin>=1.5,<2" numpy pytest
-# The crate is outside the cargo workspace (it links against Python): its own style checks.
-cargo fmt --manifest-path "$ROOT/crates/verne-py/Cargo.toml" -- --check
-(cd "$ROOT/crates/verne-py" && cargo clippy -q -- -D warnings)
 cargo build --release -q -p verne-cli
 export VIRTUAL_ENV="$VENV"
 (cd "$ROOT/crates/verne-py" && "$VENV/bin/maturin" develop --release -q)

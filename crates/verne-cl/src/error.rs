@@ -424,6 +424,10 @@ impl fmt::Display for ClErrorKind {
             ArcPointOrder => f.write_str(
                 "point after CIRCLE is not between the previous point and the end in the direction of travel",
             ),
+            ArcTooManyPoints { needed, limit } if *needed == u64::MAX => write!(
+                f,
+                "arc needs more than 1e18 points at the chord tolerance (the limit is {limit}): raise the tolerance"
+            ),
             ArcTooManyPoints { needed, limit } => write!(
                 f,
                 "arc needs {needed} points at the chord tolerance, more than the limit {limit}: raise the tolerance"

@@ -772,8 +772,19 @@ impl<R> Lexer<R> {
 
     /// An error about field `i` of the current record.
     pub(super) fn err_field(&self, i: usize, kind: ClErrorKind) -> ClError {
+        ClError::new(self.rec_line, self.field_column(i), kind)
+    }
+
+    /// The column where the current record starts.
+    pub(super) fn record_column(&self) -> u64 {
+        self.rec_col
+    }
+
+    /// The column of field `i` of the current record (of its end when it has fewer fields);
+    /// `None` on a continuation line.
+    pub(super) fn field_column(&self, i: usize) -> Option<u64> {
         let at = self.fields.get(i).map_or(self.content.len(), |f| f.0);
-        ClError::new(self.rec_line, self.column_of(at), kind)
+        self.column_of(at)
     }
 
     /// Reads fields `0..out.len()` as numbers (each must be a finite number).

@@ -46,6 +46,9 @@ struct Feed {
 #[derive(Debug, Clone, Copy)]
 struct PendingCircle {
     line: u64,
+    /// Column of the record's start, and of its radius field when it has one.
+    column: Option<u64>,
+    radius_column: Option<u64>,
     c: V3,
     axis: V3,
     radius: Option<f64>,
@@ -1311,6 +1314,8 @@ impl<R: BufRead> Reader<R> {
         }
         self.circle = Some(PendingCircle {
             line: self.lex.rec_line,
+            column: Some(self.lex.record_column()),
+            radius_column: radius.and(self.lex.field_column(6)),
             c,
             axis,
             radius,
@@ -1325,7 +1330,13 @@ impl<R: BufRead> Reader<R> {
         let Some(c) = self.circle.take() else {
             return Ok(());
         };
-        let at = |k: ClErrorKind| ClError::at(c.line, k);
+        let at = |k: ClErrorKind| {
+            let column = match k {
+                ClErrorKind::ArcRadiusGiven { .. } => c.radius_column.or(c.column),
+                _ => c.column,
+            };
+            ClError::new(c.line, column, k)
+        };
         let start = self
             .pos
             .ok_or_else(|| at(ClErrorKind::CircleBeforePosition))?;

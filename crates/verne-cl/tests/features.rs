@@ -525,6 +525,11 @@ fn arc_errors() {
         assert_eq!(e.line, line, "{t}: {e}");
         assert!(format!("{:?}", e.kind).starts_with(kind), "{t}: {e:?}");
     }
+    // The arc's errors name the CIRCLE record's column, a stated radius its own field's.
+    let e = err(&format!("{base}CIRCLE/0,0,0,0,0,1,10\nGOTO/0,11,0\n"));
+    assert_eq!((e.line, e.column), (3, Some(1)), "{e}");
+    let e = err(&format!("{base}CIRCLE/0,0,0,0,0,1,9\nGOTO/0,10,0\n"));
+    assert_eq!((e.line, e.column), (3, Some(20)), "{e}");
     // comments, PAINT, FEDRAT between CIRCLE and GOTO are fine; the FEDRAT applies to the arc
     let (rows, _) = read(&format!(
         "{base}CIRCLE/0,0,0,0,0,1,10\n$$ c\nPAINT/COLOR,1\nFEDRAT/77\nPPRINT x\nGOTO/0,10,0\n"

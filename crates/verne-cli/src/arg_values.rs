@@ -179,9 +179,16 @@ pub fn parse_ratio(s: &str) -> Result<f64, String> {
 
 /// Parses a finite number > 0.
 pub fn parse_positive(s: &str) -> Result<f64, String> {
-    match parse_ratio(s)? {
-        v if v > 0.0 => Ok(v),
-        v => Err(format!("{v} is not > 0")),
+    let v = parse_ratio(s)?;
+    let shown = verne::error::shown(s.trim().as_bytes());
+    let digits = s.trim().chars().any(|c| ('1'..='9').contains(&c));
+    match v {
+        v if v >= f64::MIN_POSITIVE => Ok(v),
+        v if v >= 0.0 && digits => Err(format!(
+            "`{shown}` is too small to be used (below {:e}, it rounds to 0 or loses its digits): expected a number > 0",
+            f64::MIN_POSITIVE
+        )),
+        _ => Err(format!("`{shown}` is not > 0")),
     }
 }
 

@@ -71,6 +71,14 @@ pub enum Command {
     /// speeds and accelerations. One report row per violation.
     #[command(after_help = crate::report::verify::help_text())]
     Verify(VerifyArgs),
+    /// Calibrate a machine file from measurements of the real machine (tracker, the module
+    /// alone, double ballbar, probe), saying what they cannot determine; or plan the poses.
+    #[command(
+        after_help = CALIBRATE_HELP,
+        args_conflicts_with_subcommands = true,
+        subcommand_negates_reqs = true
+    )]
+    Calibrate(CalibrateArgs),
     /// Print a shell completion script.
     #[command(
         after_help = "Example:\n  verne completions bash > ~/.local/share/bash-completion/completions/verne"
@@ -491,6 +499,137 @@ pub struct VerifyArgs {
     /// The servo period of a recording (1ms, 250us, 0.001s): sample k is at k x period.
     #[arg(long, value_name = "PERIOD", requires = "recording", value_parser = crate::toolpath::resample::parse_period)]
     pub period: Option<f64>,
+}
+
+const CALIBRATE_HELP: &str = "\
+Examples:
+  verne calibrate data/calibration/tracker.csv -o calibrated.toml --report ident.csv
+  verne calibrate data/calibration/tracker.csv data/calibration/ballbar.csv -o calibrated.toml
+  verne calibrate plan --device tracker --poses 30 -o poses.csv
+
+Measurements (CSV, one device per file; several files are fitted together, each instrument
+placed on its own): rho1,rho2,rho3 (mm) and theta1,theta2 (degrees unless --radians; optional
+but for a ballbar), then
+  x,y,z          the tool tip in the instrument's frame (laser tracker, CMM), optionally i,j,k
+                 the tool axis (tip towards spindle)
+  xp,yp,zp       the platform point in the instrument's frame (the module alone)
+  distance       tool ball to a table ball whose place is unknown (double ballbar)
+  height         the tool tip's height on a plane (probe)
+The output is a machine file `base = \"<nominal>\"` with the identified keys; the summary says
+what the readings cannot determine (those parameters stay at nominal), the 1 sigma of each
+identified one, the residuals before and after and on held-out rows (docs/calibration.md).
+
+Exit codes: 0 calibrated, 1 a row or a check failed (nothing written), 2 fatal.";
+
+/// `verne calibrate`.
+#[derive(Debug, Args)]
+pub struct CalibrateArgs {
+    #[command(subcommand)]
+    pub plan: Option<CalibrateCommand>,
+    /// Measurement files (CSV), one device each.
+    #[arg(value_name = "MEAS.csv", required = true)]
+    pub measurements: Vec<PathBuf>,
+    /// The calibrated machine file (TOML, written atomically).
+    #[arg(
+        short = 'o',
+        long = "output",
+        value_name = "FILE.toml",
+        required = true
+    )]
+    pub output: Option<PathBuf>,
+    /// The identifiability report (CSV): parameters, combinations held, instrument,
+    /// correlations, residuals.
+    #[arg(long, value_name = "FILE.csv")]
+    pub report: Option<PathBuf>,
+    #[command(flatten)]
+    pub fit: CalibrateFitArgs,
+    #[command(flatten)]
+    pub common: CommonArgs,
+}
+
+/// The options of a fit (`verne calibrate` and its plan).
+#[derive(Debug, Args)]
+pub struct CalibrateFitArgs {
+    /// The machine-file keys the fit may move (comma-separated), instead of those of the
+    /// devices (module.*, zeros.rho1..3, tool.length; a ballbar: zeros, tool.length, table.*).
+    #[arg(long, value_name = "KEYS", value_delimiter = ',')]
+    pub free: Vec<String>,
+    /// Keys held at their nominal values (comma-separated).
+    #[arg(long, value_name = "KEYS", value_delimiter = ',')]
+    pub fixed: Vec<String>,
+    /// The readings' noise, 1 sigma per coordinate (mm): the weights, and a plan's sigmas.
+    #[arg(long, value_name = "MM", default_value_t = verne::calibrate::DEFAULT_NOISE.length_mm, value_parser = parse_positive)]
+    pub noise: f64,
+    /// The tool axis's noise, 1 sigma per coordinate (rad).
+    #[arg(long, value_name = "RAD", default_value_t = verne::calibrate::DEFAULT_NOISE.axis_rad, value_parser = parse_positive)]
+    pub noise_axis: f64,
+    /// A prior bound KEY=BOUND (mm, degrees for angles; repeatable): a fit that moves the key
+    /// farther from nominal is refused. Default 5 mm, 1 degree.
+    #[arg(long, value_name = "KEY=BOUND", value_parser = crate::cmd::calibrate::parse_prior)]
+    pub prior: Vec<(String, f64)>,
+    /// Accept parameters that move beyond their prior bounds.
+    #[arg(long)]
+    pub allow_large: bool,
+    /// Folds of the hold-out (each fold's rows predicted by a fit of the others; 0: none).
+    #[arg(long, value_name = "K", default_value_t = verne::calibrate::DEFAULT_FOLDS as u32, value_parser = clap::value_parser!(u32).range(0..=1000))]
+    pub folds: u32,
+}
+
+/// `verne calibrate plan`.
+#[derive(Debug, Subcommand)]
+pub enum CalibrateCommand {
+    /// Plan the poses to measure: joint sets inside the workspace that maximise the
+    /// determinant of the information matrix (D-optimal), with the predicted 1 sigma of every
+    /// parameter and of the tool tip.
+    Plan(CalibratePlanArgs),
+}
+
+/// The devices of a plan.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum CalibrationDevice {
+    /// Tool tip in the instrument's frame (laser tracker, CMM).
+    Tracker,
+    /// The platform point (the module alone).
+    Platform,
+    /// Double ballbar: tool ball to a table ball.
+    Ballbar,
+    /// Heights of the tool tip on a plane.
+    Probe,
+}
+
+#[derive(Debug, Args)]
+pub struct CalibratePlanArgs {
+    /// The instrument.
+    #[arg(long, value_enum)]
+    pub device: CalibrationDevice,
+    /// Poses to measure.
+    #[arg(long, value_name = "N", default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..=100000))]
+    pub poses: u32,
+    /// Candidate poses drawn inside the workspace.
+    #[arg(long, value_name = "N", default_value_t = 1500, value_parser = clap::value_parser!(u32).range(1..=200000))]
+    pub candidates: u32,
+    /// A tracker also reads the tool axis.
+    #[arg(long)]
+    pub axis: bool,
+    /// Ballbar: the bar's length (mm).
+    #[arg(long, value_name = "MM", default_value_t = 100.0, value_parser = parse_positive)]
+    pub bar: f64,
+    /// Ballbar: the table ball in the workpiece frame X,Y,Z (mm).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_triple, allow_hyphen_values = true)]
+    pub ball: Option<[f64; 3]>,
+    /// Seed of the candidates' draw.
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub seed: u64,
+    /// The poses (CSV): joints, and what the nominal machine's instrument would read there.
+    #[arg(short = 'o', long = "output", value_name = "FILE.csv")]
+    pub output: Option<PathBuf>,
+    /// The predicted sigmas (CSV).
+    #[arg(long, value_name = "FILE.csv")]
+    pub report: Option<PathBuf>,
+    #[command(flatten)]
+    pub fit: CalibrateFitArgs,
+    #[command(flatten)]
+    pub common: CommonArgs,
 }
 
 #[cfg(test)]

@@ -1,4 +1,4 @@
-//! Errors that stop a run of the command (exit code 2), each naming the file, line and column
+//! Errors that stop a run of the command (exit code 2, or 1 for a row that failed), each naming the file, line and column
 //! where it applies: the core's typed errors converted once, and the command's own (I/O, input
 //! data, usage).
 
@@ -23,6 +23,10 @@ pub enum VerneError {
     Io { file: String, error: std::io::Error },
     /// A bad command-line value.
     Usage(String),
+    /// A row the output cannot do without has no answer (an unreachable pose in a joint
+    /// program): the run stops there, writes nothing to a file, and exits 1 (a row failed), not
+    /// 2. Its text is an [`VerneError::Input`]'s.
+    RowFailed(Box<VerneError>),
 }
 
 impl VerneError {
@@ -44,6 +48,14 @@ impl VerneError {
         VerneError::Io {
             file: file.to_string(),
             error,
+        }
+    }
+
+    /// The exit code of the run it ends: 1 for a row that failed, 2 for the rest.
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            VerneError::RowFailed(_) => crate::cmd::EXIT_ROWS_FAILED,
+            _ => crate::cmd::EXIT_FATAL,
         }
     }
 
@@ -74,6 +86,7 @@ impl fmt::Display for VerneError {
             VerneError::Machine(e) => write!(f, "{e}"),
             VerneError::Io { file, error } => write!(f, "{file}: {error}"),
             VerneError::Usage(m) => f.write_str(m),
+            VerneError::RowFailed(e) => e.fmt(f),
         }
     }
 }

@@ -6,7 +6,8 @@ use std::io::Cursor;
 
 use crate::engine::module_rows::{ModuleFkAll, ModuleFkWorking, ModuleIkAll, ModuleIkWorking};
 use crate::engine::pipeline::{self, Units};
-use crate::table::{CsvSource, Sink};
+use crate::files::Sink;
+use crate::table::CsvSource;
 use verne::machine::FirstRowChoice;
 use verne::spec::Machine;
 

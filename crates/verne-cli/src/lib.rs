@@ -52,6 +52,7 @@ pub mod cli;
 pub mod cmd;
 pub mod engine;
 pub mod error;
+pub mod files;
 pub mod follow;
 pub mod fuzz_entry;
 pub mod input;
@@ -73,7 +74,7 @@ pub fn run() -> ExitCode {
     if let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) {
         std::thread::spawn(move || {
             if let Some(signal) = signals.forever().next() {
-                table::remove_temp_files();
+                files::remove_temp_files();
                 std::process::exit(128 + signal);
             }
         });
@@ -107,6 +108,7 @@ pub fn run() -> ExitCode {
         cli::Command::Workspace(a) => cmd::workspace::run(a),
         cli::Command::Selftest(a) => cmd::selftest::run(a),
         cli::Command::Verify(a) => cmd::verify::run(a),
+        cli::Command::Calibrate(a) => cmd::calibrate::run(a),
         cli::Command::Completions { shell } => cmd::shell::completions(*shell),
         cli::Command::Manpage => cmd::shell::manpage(),
     };
@@ -115,11 +117,11 @@ pub fn run() -> ExitCode {
         Ok(code) => ExitCode::from(code),
         Err(e) if e.is_broken_pipe() => ExitCode::from(cmd::EXIT_OK),
         Err(e) => {
-            table::remove_temp_files();
+            files::remove_temp_files();
             // Errors are written whatever the verbosity.
             use std::io::Write as _;
             let _ = writeln!(std::io::stderr(), "verne: error: {e}");
-            ExitCode::from(cmd::EXIT_FATAL)
+            ExitCode::from(e.exit_code())
         }
     }
 }

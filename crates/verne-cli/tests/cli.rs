@@ -476,13 +476,13 @@ fn prefer_is_honoured_where_a_vertical_start_decides_and_theta2_does_not_swing()
     assert_ne!(table(&piped).1[0][col(&table(&piped).0, "theta2")], "0");
 }
 
-/// A joint list (halstreamer, G-code) stops at a row it cannot solve: to a file nothing is
+/// A joint list (halstreamer, G-code) stops at a row it cannot solve (exit 1, a row failed): to a file nothing is
 /// written; to stdout the rows before it may already be in the pipe, and the error says so.
 #[test]
 fn a_stopped_joint_list_on_stdout_is_called_incomplete() {
     let path = "x,y,z,i,j,k\n0,0,150,0,0,1\n5000,0,0,0,0,1\n";
     let out = run(&["ik", "--format", "halstreamer"], Some(path));
-    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
         err.contains("<stdin>:3") && err.contains("incomplete"),
@@ -501,7 +501,7 @@ fn a_stopped_joint_list_on_stdout_is_called_incomplete() {
         ],
         Some(path),
     );
-    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!err.contains("incomplete"), "{err}");
     assert!(!file.exists());

@@ -12,7 +12,7 @@ const PRESETS: [&str; 3] = ["biglide1", "biglide2", "orthoglide"];
 /// Joints read back after fk -> ik (multiples of L).
 const ROUND_TRIP_TOL: f64 = 1e-9;
 
-/// Issue 6: L0 and delta-rho of Table 1 within 1 % of the paper, S within 5 %.
+/// L0 and delta-rho of Table 1 within 1 % of the paper, S within 5 %.
 const DIMENSION_REL_TOL: f64 = 0.01;
 const S_REL_TOL: f64 = 0.05;
 

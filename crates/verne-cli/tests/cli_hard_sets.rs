@@ -8,7 +8,7 @@ mod common;
 use verne::parallel_module::fk;
 use verne::spec::Machine;
 
-/// The 11-row path, 0.002 mm steps of rho2 across the thin set of the default machine:
+/// An 11-row path, 0.002 mm steps of rho2 across the thin set of the default machine:
 /// `verne fk` gives the working mode on every row (tracked or solved), and `verne verify` of the
 /// machine joints against the tool poses `verne fk` computes for them is clean (no false
 /// `branch` finding).

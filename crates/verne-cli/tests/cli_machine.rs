@@ -235,8 +235,34 @@ fn halstreamer_writes_only_joints() {
         &["ik", "--format", "halstreamer", "--tool", "5000,0,0,0,0,1"],
         None,
     );
-    assert_eq!(unreachable.status.code(), Some(2));
+    // An unreachable pose is an answer (a row that failed: exit 1), not a fatal error.
+    assert_eq!(unreachable.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&unreachable.stderr).contains("cannot leave out a row"));
+    // Into a file: nothing is written.
+    let dir = std::env::temp_dir().join(format!("verne-unreachable-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("p.csv");
+    std::fs::write(
+        &path,
+        "x,y,z,i,j,k,feed\n0,0,30,0,0,1,1000\n2000,0,30,0,0,1,1000\n",
+    )
+    .unwrap();
+    let program = dir.join("p.ngc");
+    let out = run(
+        &[
+            "ik",
+            path.to_str().unwrap(),
+            "--format",
+            "gcode",
+            "-o",
+            program.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("p.csv:3: row status `unreachable`"));
+    assert!(!program.exists());
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]

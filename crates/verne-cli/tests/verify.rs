@@ -161,10 +161,20 @@ fn verify_files(tag: &str, jp: &PathBuf, pp: &PathBuf, extra: &[&str]) -> Run {
         let mut rd = csv::Reader::from_reader(text.as_bytes());
         assert_eq!(
             rd.headers().unwrap(),
-            vec!["row", "check", "value", "limit", "detail"]
+            vec![
+                "row",
+                "check",
+                "value",
+                "limit",
+                "detail",
+                "joints_line",
+                "path_line"
+            ]
         );
         for r in rd.records() {
             let r = r.unwrap();
+            // Every finding names the joint table's line (and the path's, when paired).
+            assert!(r[5].parse::<u64>().is_ok(), "{r:?}");
             findings.push(Finding {
                 row: r[0].to_string(),
                 check: r[1].to_string(),

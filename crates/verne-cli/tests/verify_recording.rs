@@ -192,10 +192,15 @@ fn a_halsampler_recording_with_tags_extra_columns_and_an_overrun() {
     let (code, rows, err) = verify(&dir, "samples.txt", &rec, &cols);
     assert_eq!(code, 1, "{err}");
     let other = checks_besides_acceleration(&rows);
-    // The overrun line is the one input finding (line 3001 of the file), nothing else.
-    assert_eq!(other.len(), 1, "{other:?}");
+    // The overrun line is the one input finding (line 3001 of the file); the first 5000
+    // samples do not reach the path's end, which is a finding of its own; nothing else.
+    assert_eq!(other.len(), 2, "{other:?}");
     assert!(
         other[0].starts_with("3001,input,") && other[0].contains("overrun"),
+        "{other:?}"
+    );
+    assert!(
+        other[1].contains(",pairing,") && other[1].contains("before its last point"),
         "{other:?}"
     );
     // Times from the tags: the gap of 10 samples is 11 ms, not 1 (no speed finding there).
@@ -245,4 +250,43 @@ fn recording_options_go_together() {
         let out = run(&args, None);
         assert_eq!(out.status.code(), Some(2), "{args:?}");
     }
+}
+
+/// A recording must cover its path: an empty one, one of blank lines, or its first 1 % is a
+/// finding, never clean; its tags are sample numbers that increase.
+#[test]
+fn a_recording_that_covers_nothing_or_part_of_the_path_is_a_finding() {
+    let dir = scratch("coverage");
+    let lines = stream(&dir);
+    let first = lines.len() / 100;
+    for (name, rec) in [
+        ("empty.txt", Vec::new()),
+        ("blank.txt", vec![String::new(), "   ".to_string()]),
+        ("part.txt", lines[..first].to_vec()),
+    ] {
+        let (code, rows, err) = verify(&dir, name, &rec, &[]);
+        assert_eq!(code, 1, "{name}: {err}");
+        assert!(
+            rows.iter().any(|r| r.contains(",pairing,")),
+            "{name}: {rows:?}"
+        );
+    }
+    let whole = verify(&dir, "whole.txt", &lines, &[]);
+    assert!(
+        !whole.1.iter().any(|r| r.contains(",pairing,")),
+        "{:?}",
+        whole.1
+    );
+    let cols = ["--columns", "tag,rho1,rho2,rho3,theta1,theta2"];
+    for (name, tags) in [("back.txt", [5.0, 7.0, 6.0]), ("half.txt", [5.0, 5.5, 6.0])] {
+        let rec: Vec<String> = tags
+            .iter()
+            .zip(&lines)
+            .map(|(t, l)| format!("{t} {l}"))
+            .collect();
+        let (code, _, err) = verify(&dir, name, &rec, &cols);
+        assert_eq!(code, 2, "{name}: {err}");
+        assert!(err.contains("column tag"), "{name}: {err}");
+    }
+    let _ = fs::remove_dir_all(&dir);
 }

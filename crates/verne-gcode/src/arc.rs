@@ -11,6 +11,9 @@ use super::error::GcodeError;
 use super::reader::{Feed, Plane, State, target};
 use super::types::{Axis, Kind, Motion, Options, Row};
 
+/// The most turns an arc's `P` word may ask for (each turn is interpolated).
+pub const MAX_ARC_TURNS: f64 = 10_000.0;
+
 /// The words of an arc block.
 pub(crate) struct ArcWords<'a> {
     pub axes: &'a [Option<(f64, Word)>; 9],
@@ -63,11 +66,13 @@ pub(crate) fn interpolate(
     let (e0, e1) = (end[a0 as usize], end[a1 as usize]);
     let turns_extra = match w.p {
         None => 0.0,
-        Some((p, _)) if p >= 1.0 && p.fract() == 0.0 && p <= 10_000.0 => p - 1.0,
-        Some((_, pw)) => {
+        Some((p, _)) if p >= 1.0 && p.fract() == 0.0 && p <= MAX_ARC_TURNS => p - 1.0,
+        Some((p, pw)) => {
             return err(
                 &pw,
-                "P on an arc is the number of turns: an integer >= 1".into(),
+                format!(
+                    "P on an arc is the number of turns: a whole number from 1 to {MAX_ARC_TURNS}, found {p}"
+                ),
             );
         }
     };

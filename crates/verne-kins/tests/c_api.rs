@@ -236,3 +236,93 @@ fn near_singularity_and_bad_machine_files_are_reported() {
         .into_owned();
     assert!(msg.contains("lambda_max"), "{msg}");
 }
+
+/// The machine file's offsets through the C interface: the zero offsets of the sliders and the
+/// table axes only rename the joints (a machine without them, its limits moved by them by
+/// hand, gives the joints plus the offsets), the rotary axis's offset y_t enters both ways, and
+/// the forward gives the inverse's pose back.
+#[test]
+fn the_machine_files_offsets_are_applied() {
+    let dir = std::env::temp_dir().join(format!("verne-kins-zeros-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let rho_zero = [0.4, -0.3, 0.2];
+    let theta_zero_deg = [0.05, -0.1];
+    let mut offsets = verne::spec::Machine::default_verne();
+    offsets.module.rho_zero = rho_zero;
+    offsets.table.theta_zero = theta_zero_deg.map(f64::to_radians);
+    offsets.table.y_t = 0.25;
+    let mut hand = verne::spec::Machine::default_verne();
+    hand.table.y_t = 0.25;
+    for (k, z) in rho_zero.iter().enumerate() {
+        hand.limits.rho_min[k] += z;
+        hand.limits.rho_max[k] += z;
+    }
+    hand.limits.theta1_min += theta_zero_deg[0].to_radians();
+    hand.limits.theta1_max += theta_zero_deg[0].to_radians();
+    let open = |m: &verne::spec::Machine, name: &str| {
+        let file = dir.join(name);
+        std::fs::write(&file, m.to_toml()).unwrap();
+        let path = std::ffi::CString::new(file.to_str().unwrap()).unwrap();
+        let mut err = [0 as std::ffi::c_char; 256];
+        let k = unsafe { verne_kins_new(path.as_ptr(), err.as_mut_ptr(), err.len()) };
+        assert!(!k.is_null(), "{:?}", unsafe {
+            CStr::from_ptr(err.as_ptr())
+        });
+        k
+    };
+    let (ko, kh) = (open(&offsets, "offsets.toml"), open(&hand, "hand.toml"));
+    let inverse = |k: *mut VerneKins, world: &[f64; 5]| {
+        let mut joints = [300.0, 250.0, 250.0, 0.0, 0.0];
+        let s = unsafe {
+            verne_kins_inverse(
+                k,
+                world.as_ptr(),
+                joints.as_mut_ptr(),
+                VERNE_KINS_COMPLETE,
+                std::ptr::null_mut(),
+            )
+        };
+        assert_eq!(s, VerneKinsStatus::Ok, "{world:?}");
+        joints
+    };
+    let zero = [
+        rho_zero[0],
+        rho_zero[1],
+        rho_zero[2],
+        theta_zero_deg[0],
+        theta_zero_deg[1],
+    ];
+    for world in [
+        [10.0, -20.0, 5.0, 12.0, 30.0],
+        [-30.0, 15.0, 20.0, 20.0, -60.0],
+        [40.0, 30.0, -10.0, 8.0, 135.0],
+    ] {
+        let (j, h) = (inverse(ko, &world), inverse(kh, &world));
+        for d in 0..5 {
+            assert!(
+                (j[d] + zero[d] - h[d]).abs() < 1e-9,
+                "{j:?} + offsets vs {h:?}"
+            );
+        }
+        let mut back = [0.0, 0.0, 0.0, 0.0, world[4]];
+        let s = unsafe {
+            verne_kins_forward(ko, j.as_ptr(), back.as_mut_ptr(), 0, std::ptr::null_mut())
+        };
+        assert_eq!(s, VerneKinsStatus::Ok);
+        for d in 0..5 {
+            assert!((back[d] - world[d]).abs() < 1e-7, "{back:?} vs {world:?}");
+        }
+    }
+    // Without y_t the same joints are another pose: the machine's y_t is used.
+    let mut no_yt = offsets.clone();
+    no_yt.table.y_t = 0.0;
+    let kn = open(&no_yt, "no_yt.toml");
+    let world = [10.0, -20.0, 5.0, 12.0, 30.0];
+    let (a, b) = (inverse(ko, &world), inverse(kn, &world));
+    assert!((0..3).any(|d| (a[d] - b[d]).abs() > 1e-3), "{a:?} vs {b:?}");
+    unsafe {
+        verne_kins_free(ko);
+        verne_kins_free(kh);
+        verne_kins_free(kn);
+    }
+}

@@ -10,9 +10,7 @@ use rayon::prelude::*;
 use verne::machine::fk::MAX_MACHINE_FK_MODES;
 use verne::machine::ik::MAX_MACHINE_IK_BRANCHES;
 use verne::machine::orientation::ToolOrientation;
-use verne::machine::{
-    FirstRowChoice, PathError, PathState, first_decided_theta2, machine_fk, path_candidates,
-};
+use verne::machine::{FirstRowChoice, PathError, machine_fk, path_candidates};
 use verne::parallel_module::equations::Sliders;
 
 use crate::machine::PyMachine;
@@ -69,35 +67,33 @@ fn ik_path<'py>(
             )));
         }
     };
-    let m = &machine.inner;
-    let length = tool_length.unwrap_or(m.tool_length);
+    let base = &machine.inner;
+    let machine = base.with_tool_length(tool_length.unwrap_or(base.tool_length));
     let n = t.len();
     let (joints, orientation, status) = py.allow_threads(|| {
         let mut joints = Array2::<f64>::from_elem((n, 5), f64::NAN);
         let mut orientation = Array1::<i8>::zeros(n);
         let mut status = Array1::<i8>::zeros(n);
-        // A path that starts with the tool vertical: its orientation is decided at its first
-        // tilted pose, and the vertical rows take the theta2 that pose needs (as `verne ik`).
-        let poses = (0..n)
-            .filter(|&i| t[i].iter().chain(&a[i]).all(|v| v.is_finite()))
+        let Some(m) = machine else {
+            // A tool length that is not finite or is negative: no row can be solved.
+            status.fill(INVALID_INPUT);
+            return (joints, orientation, status);
+        };
+        let poses: Vec<_> = (0..n)
             .map(|i| {
                 (
                     nalgebra::Vector3::from(t[i]),
                     ToolOrientation::Axis(nalgebra::Vector3::from(a[i])),
                 )
-            });
-        let mut state = match first_decided_theta2(m, poses, length, first) {
-            Some(theta2) => PathState::with_theta2(first, theta2),
-            None => PathState::new(first),
-        };
-        for i in 0..n {
-            let tip = nalgebra::Vector3::from(t[i]);
-            let axis = ToolOrientation::Axis(nalgebra::Vector3::from(a[i]));
-            if !(t[i].iter().chain(&a[i]).all(|v| v.is_finite()) && length.is_finite()) {
+            })
+            .collect();
+        // The path follower of `verne ik`, look-ahead at a vertical start included.
+        for (i, row) in m.follow_path(&poses, first).into_iter().enumerate() {
+            if !t[i].iter().chain(&a[i]).all(|v| v.is_finite()) {
                 status[i] = INVALID_INPUT;
                 continue;
             }
-            match state.next_row(m, &tip, &axis, length) {
+            match row {
                 Ok(row) => {
                     for (j, v) in [row.rho.x, row.rho.y, row.rho.z, row.theta1, row.theta2]
                         .into_iter()

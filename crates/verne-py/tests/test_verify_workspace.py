@@ -39,7 +39,8 @@ def test_verify_finds_what_verne_verify_finds(tmp_path):
     lines = report.read_text().strip().splitlines()[1:]
     theirs = [(ln.split(",")[0], ln.split(",")[1], float(ln.split(",")[2])) for ln in lines]
     mine = [(f["row"], f["check"], f["value"]) for f in found]
-    assert len(mine) == len(theirs) == 8
+    # The defects injected into the table (docs/verify.md), and the gouges of its jumps.
+    assert len(mine) == len(theirs) >= 8
     for (r1, c1, v1), (r2, c2, v2) in zip(mine, theirs):
         assert (r1, c1) == (r2, c2) and math.isclose(v1, v2, rel_tol=1e-6)
     assert not summary["clean"] and summary["rows"] == 3000 and summary["timed"]

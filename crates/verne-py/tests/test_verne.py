@@ -26,7 +26,7 @@ def test_machine_files():
 
 
 def test_inverse_kinematics_reference_pose():
-    # verne-geometry.md: P = (-240, -86, 1000) has sixteen real branches, four alphas.
+    # docs/reference-results.md: P = (-240, -86, 1000) has sixteen real branches, four alphas.
     b, config, working, count, proved = verne.module_ik(M, np.array([[-240.0, -86.0, 1000.0]]))
     assert b.shape == (1, 24, 4) and config.dtype == np.int8 and working.dtype == bool
     assert count[0] == 16 and proved[0]
@@ -160,3 +160,45 @@ def test_compact_and_padded_forms_agree():
     fb, _, fw, fn, _ = verne.module_fk(M, sl)
     cfb, _, _, _, foff, _ = verne.module_fk_compact(M, sl)
     assert (np.diff(foff) == fn).all() and np.array_equal(cfb, fb[~np.isnan(fb[:, :, 0])])
+
+
+def test_results_are_named_and_unpack_in_order():
+    """Each result names its arrays in the order they unpack; the names are the ones the stubs
+    declare; statuses are `Status` values equal to the integers."""
+    pts = np.array([[-240.0, -86.0, 1000.0], [1e4, 0.0, 0.0]])
+    ik = verne.module_ik(M, pts)
+    assert isinstance(ik, verne.ModuleBranches)
+    b, c, w, n, p = ik
+    assert ik.branches is b and ik.config is c and ik.working is w and ik.count is n and ik.proved is p
+    assert n.tolist() == [16, 0]
+    assert np.array_equal(ik.working_branch(), verne.working(b, w), equal_nan=True)
+    sl, alpha, status = verne.module_ik_working(M, pts)
+    assert verne.module_ik_working(M, pts).status.tolist() == status.tolist()
+    assert [verne.Status(s) for s in status] == [verne.Status.OK, verne.Status.UNREACHABLE]
+    assert verne.OK == 0 and verne.Status.INVALID_INPUT == 3
+    tips = np.array([[80.0, 0.0, 30.0]])
+    axes = np.array([[0.342020, 0.0, 0.939693]])
+    path = verne.ik_path(M, tips, axes)
+    back = verne.machine_fk_working(M, path.joints)
+    assert np.allclose(back.tips, tips, atol=1e-6) and back.status.tolist() == [verne.Status.OK]
+    every = verne.machine_ik(M, tips, axes)
+    assert every.count[0] >= 1 and np.isfinite(every.working_branch()).all()
+    modes = verne.machine_fk(M, path.joints)
+    assert np.allclose(modes.tips[0][modes.working[0]][0], tips[0], atol=1e-6)
+    g = verne.Glider.preset("orthoglide")
+    fk = verne.glider_fk(g, np.array([[0.5, 0.6]]))
+    assert fk.solutions.count.tolist() == [2] and fk.structural.tolist() == [False]
+    # The stubs declare the same fields, in the same order.
+    import ast
+    import pathlib
+
+    stub = pathlib.Path(verne.__file__).with_suffix(".pyi")
+    classes = {
+        node.name: [f.target.id for f in node.body if isinstance(f, ast.AnnAssign)]
+        for node in ast.parse(stub.read_text()).body
+        if isinstance(node, ast.ClassDef)
+    }
+    for name in ["ModuleBranches", "CompactBranches", "ModuleWorking", "PathJoints", "ToolPoses",
+                 "MachineBranches", "MachineModes", "Jacobians", "GliderSolutions", "GliderModes",
+                 "Verification"]:
+        assert classes[name] == list(getattr(verne, name)._fields), name

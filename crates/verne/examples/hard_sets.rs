@@ -1,4 +1,4 @@
-//! The full count of issue 22's constructed poses (docs/reliability.md): the forward kinematics
+//! The full count of the constructed poses on the solvers' degenerate sets (docs/reliability.md): the forward kinematics
 //! of the module, its inverse kinematics and the machine's inverse kinematics on poses built on
 //! the solvers' degenerate sets, on the default machine and ten random valid geometries.
 //!

@@ -1,6 +1,6 @@
 //! Reference results of the parallel module: Table III of IFToMM 2007 (forward kinematics of
-//! rho = (674, 685, 250) mm), and the reference tables of shared/reference/verne-geometry.md
-//! computed with the default geometry (inverse kinematics of P = (-240, -86, 1000) mm, the
+//! rho = (674, 685, 250) mm), and the reference results of the default geometry
+//! (docs/reference-results.md), computed with the default geometry (inverse kinematics of P = (-240, -86, 1000) mm, the
 //! y_p = 0 special case P = (-300, 0, 1100) mm and the forward kinematics of its working
 //! joints).
 //!
@@ -80,7 +80,7 @@ fn find_mode(modes: &[FkMode], alpha: f64, p: [f64; 3], rad: f64, mm: f64) -> &F
 
 // ---------------------------------------------------------------- Table III
 
-/// Table III of IFToMM 2007 (also /work/shared/reference/table3.csv): rho = (674, 685, 250) mm;
+/// Table III of IFToMM 2007: rho = (674, 685, 250) mm;
 /// (case, alpha "t (rd)", xp, yp, zp).
 const TABLE3: [(&str, f64, f64, f64, f64); 4] = [
     ("a", -0.22, -199.80, 355.92, 1242.0),

@@ -87,6 +87,9 @@ pub fn run(args: &IkArgs) -> Result<u8, VerneError> {
         ));
     }
     crate::arg_values::spatial(&args.pose, "--pose", "XP,YP,ZP").map_err(VerneError::Usage)?;
+    if let (Some(o), Some(r)) = (&args.output, &args.schedule_report) {
+        crate::files::check_distinct_outputs(&[("-o", o), ("--schedule-report", r)])?;
+    }
     if !args.pose.is_empty() {
         let source = inline_source(
             &["xp", "yp", "zp"],
@@ -280,8 +283,12 @@ fn follow_path(
     }
     if let Err(mut e) = result {
         sink.discard();
+        let input = match &mut e {
+            VerneError::RowFailed(inner) => inner.as_mut(),
+            other => other,
+        };
         if let (Some(_), true, VerneError::Input { message, .. }) =
-            (program, to_stdout(output), &mut e)
+            (program, to_stdout(output), input)
         {
             // A file is never left partial; a pipe may have received the rows before.
             message.push_str(
@@ -348,18 +355,18 @@ fn follow_path(
 fn report_post(cmd: &str, name: &str, r: &PostReport, program: bool) {
     if r.inserted > 0 || !r.not_linearized.is_empty() {
         sayln!(
-            "verne {cmd}: {name}: linearized: {} rows, {} poses inserted",
-            r.rows,
-            r.inserted
+            "verne {cmd}: {name}: linearized: {}, {} inserted",
+            counted(r.rows, "row", "rows"),
+            counted(r.inserted, "pose", "poses")
         );
     }
     if r.timed_blocks > 0 {
         sayln!(
-            "verne {cmd}: {name}: scheduled: {} feed blocks in {:.3} s ({:.3} s at the programmed feeds alone); {} blocks slowed by the drives' limits",
-            r.timed_blocks,
+            "verne {cmd}: {name}: scheduled: {} in {:.3} s ({:.3} s at the programmed feeds alone); {} slowed by the drives' limits",
+            counted(r.timed_blocks, "feed block", "feed blocks"),
             r.time_s,
             r.feed_time_s,
-            r.slowed
+            counted(r.slowed, "block", "blocks")
         );
     }
     for (line, why) in &r.not_linearized {
@@ -367,10 +374,18 @@ fn report_post(cmd: &str, name: &str, r: &PostReport, program: bool) {
     }
     if !r.not_linearized.is_empty() && program {
         sayln!(
-            "verne {cmd}: {name}: no program written: {} moves cannot be linearized within the tolerances (exit 1)",
-            r.not_linearized.len()
+            "verne {cmd}: {name}: no program written: {} linearized within the tolerances (exit 1)",
+            match r.not_linearized.len() {
+                1 => "1 move cannot be".to_string(),
+                n => format!("{n} moves cannot be"),
+            }
         );
     }
+}
+
+/// `n` with its noun, singular for one.
+fn counted(n: u64, one: &str, many: &str) -> String {
+    format!("{n} {}", if n == 1 { one } else { many })
 }
 
 /// Writes the schedule report (CSV, atomically).
@@ -387,8 +402,8 @@ fn write_schedule_report(path: &Path, lines: &[ScheduleLine]) -> Result<(), Vern
             l.block, l.line, l.share, l.feed_time_s, l.time_s
         ));
     }
-    crate::table::check_output_path(path)
-        .and_then(|_| crate::table::write_output(path, text.as_bytes()))
+    crate::files::check_output_path(path)
+        .and_then(|_| crate::files::write_output(path, text.as_bytes()))
         .map_err(|e| VerneError::io(&path.display().to_string(), e))
 }
 

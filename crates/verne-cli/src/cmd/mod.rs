@@ -1,6 +1,7 @@
 //! One file per subcommand; this file holds what they share: loading the machine, opening the
 //! input and output, and turning a run's summary into an exit code.
 
+pub mod calibrate;
 pub mod design;
 pub mod fk;
 pub mod glider;
@@ -18,7 +19,8 @@ use std::time::Duration;
 
 use crate::engine::pipeline::{self, RowJob, RunSummary, Units};
 use crate::error::VerneError;
-use crate::table::{CsvSource, Sink};
+use crate::files::Sink;
+use crate::table::CsvSource;
 use verne::spec::Machine;
 
 use crate::cli::CommonArgs;
@@ -86,7 +88,7 @@ fn read_machine(path: Option<&Path>) -> Result<Machine, VerneError> {
         Some(p) if !p.exists() && p.as_os_str() == "verne" => Ok(Machine::default_verne()),
         Some(p) => {
             let name = p.display().to_string();
-            let text = crate::table::read_input_file(p).map_err(|e| VerneError::io(&name, e))?;
+            let text = crate::files::read_input_file(p).map_err(|e| VerneError::io(&name, e))?;
             let text = String::from_utf8(text).map_err(|e| {
                 let upto = &e.as_bytes()[..e.utf8_error().valid_up_to()];
                 let line = upto.iter().filter(|&&b| b == b'\n').count() as u64 + 1;
@@ -101,8 +103,13 @@ fn read_machine(path: Option<&Path>) -> Result<Machine, VerneError> {
             let dir = p.parent().map(Path::to_path_buf).unwrap_or_default();
             let resolve = |base: &str| -> Result<(String, String), String> {
                 let path = dir.join(base);
+                if !path.exists() && verne::glider::GliderSpec::preset(base).is_some() {
+                    return Err(format!(
+                        "`{base}` is a glider preset, not a VERNE machine: a VERNE machine file's base is `verne` or the path of another VERNE machine file"
+                    ));
+                }
                 let shown = path.display().to_string();
-                let bytes = crate::table::read_input_file(&path)
+                let bytes = crate::files::read_input_file(&path)
                     .map_err(|e| format!("base {shown}: {e}"))?;
                 String::from_utf8(bytes)
                     .map(|t| (t, shown.clone()))

@@ -17,11 +17,51 @@ pub fn completions(shell: clap_complete::Shell) -> Result<u8, VerneError> {
 pub fn manpage_text() -> String {
     let cmd = Cli::command();
     let mut out = Vec::new();
-    let _ = clap_mangen::Man::new(cmd.clone()).render(&mut out);
-    for sub in cmd.get_subcommands().filter(|s| !s.is_hide_set()) {
-        let _ = writeln_section(&mut out, sub);
-    }
+    let _ = render_page(&mut out, &cmd);
     String::from_utf8_lossy(&out).into_owned()
+}
+
+/// One page for the whole command: its subcommands are sections of it (`VERNE IK`, ...), not
+/// pages of their own, so the list of subcommands names those sections.
+fn render_page(out: &mut Vec<u8>, cmd: &clap::Command) -> std::io::Result<()> {
+    use std::io::Write;
+    let man = clap_mangen::Man::new(cmd.clone());
+    man.render_title(out)?;
+    man.render_name_section(out)?;
+    man.render_synopsis_section(out)?;
+    man.render_description_section(out)?;
+    man.render_options_section(out)?;
+    let subs: Vec<&clap::Command> = cmd
+        .get_subcommands()
+        .filter(|s| !s.is_hide_set() && s.get_name() != "help")
+        .collect();
+    writeln!(out, ".SH SUBCOMMANDS")?;
+    for sub in &subs {
+        let about = sub.get_about().map(|a| a.to_string()).unwrap_or_default();
+        writeln!(
+            out,
+            ".TP\n\\fBverne {}\\fR\n{} (section VERNE {} below)",
+            sub.get_name(),
+            roff_text(&about),
+            sub.get_name().to_uppercase()
+        )?;
+    }
+    man.render_extra_section(out)?;
+    for sub in subs {
+        writeln_section(out, sub)?;
+    }
+    man.render_version_section(out)
+}
+
+/// Text as roff reads it: backslashes and hyphens escaped, no line starting with a control
+/// character.
+fn roff_text(s: &str) -> String {
+    let t = s.replace('\\', "\\e").replace('-', "\\-");
+    if t.starts_with('.') || t.starts_with('\'') {
+        format!("\\&{t}")
+    } else {
+        t
+    }
 }
 
 fn writeln_section(out: &mut Vec<u8>, sub: &clap::Command) -> std::io::Result<()> {

@@ -1,11 +1,13 @@
 //! `verne verify`: a postprocessor's joint table against the intended path (docs/verify.md).
 //! Opens the files, writes the report CSV atomically, prints the summary, picks the exit code.
 
+use std::path::Path;
+
 use crate::error::VerneError;
+use crate::files::Sink;
 use crate::input::recording::{DEFAULT_COLUMNS, RecordingReader, parse_columns};
 use crate::input::verify_files::{JointInput, PathReader};
 use crate::report::verify::{short_number, summary_json, summary_text};
-use crate::table::Sink;
 use crate::toolpath::ReaderReport;
 use csv::ByteRecord;
 use verne::verify::contour::{ContourPath, verify_recording};
@@ -15,6 +17,29 @@ use super::{EXIT_OK, EXIT_ROWS_FAILED, load_machine, write_stdout};
 use crate::cli::{VerifyArgs, VerifyFormat};
 
 pub fn run(args: &VerifyArgs) -> Result<u8, VerneError> {
+    let result = checked(args);
+    if let (Err(e), VerifyFormat::Json) = (&result, args.format)
+        && !e.is_broken_pipe()
+    {
+        // A script reading the JSON gets an object whatever happened.
+        let _ = write_stdout(&format!("{}\n", crate::report::verify::error_json(e)));
+    }
+    result
+}
+
+fn checked(args: &VerifyArgs) -> Result<u8, VerneError> {
+    let stdout = Path::new("-");
+    let mut outputs: Vec<(&str, &Path)> = Vec::new();
+    if let Some(r) = &args.report {
+        outputs.push(("--report", r));
+    }
+    if let Some(s) = &args.summary {
+        outputs.push(("--summary", s));
+    }
+    if args.format == VerifyFormat::Json {
+        outputs.push(("--format json", stdout));
+    }
+    crate::files::check_distinct_outputs(&outputs)?;
     let summary_to_stdout = args.summary.as_ref().is_some_and(|p| p.as_os_str() == "-");
     if summary_to_stdout && args.format == VerifyFormat::Json {
         return Err(VerneError::Usage(
@@ -61,7 +86,13 @@ pub fn run(args: &VerifyArgs) -> Result<u8, VerneError> {
         Some(p) => {
             let mut s = Sink::create(Some(p))?;
             s.write(&ByteRecord::from(vec![
-                "row", "check", "value", "limit", "detail",
+                "row",
+                "check",
+                "value",
+                "limit",
+                "detail",
+                "joints_line",
+                "path_line",
             ]))?;
             Some(s)
         }
@@ -76,6 +107,9 @@ pub fn run(args: &VerifyArgs) -> Result<u8, VerneError> {
             rec.push_field(short_number(v.value).as_bytes());
             rec.push_field(short_number(v.limit).as_bytes());
             rec.push_field(v.detail.as_bytes());
+            let line = |l: Option<u64>| l.map_or(String::new(), |l| l.to_string());
+            rec.push_field(line(v.joints_line).as_bytes());
+            rec.push_field(line(v.path_line).as_bytes());
             s.write(&rec)?;
         }
         Ok(())

@@ -7,10 +7,10 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use crate::error::VerneError;
+use crate::files::Sink;
 use crate::plot::sweep::{SweepPoint, VOLUME_LABELS, sweep_picture};
 use crate::plot::{self, View};
 use crate::report::workspace::{POINTS_HEADER, write_point};
-use crate::table::Sink;
 use csv::ByteRecord;
 use nalgebra::Vector3;
 use verne::workspace::{
@@ -46,6 +46,15 @@ fn run_sweep(
              tool.length)"
         )));
     }
+    if let Some(key) = keys.iter().find(|k| {
+        !["module.", "limits.", "table.", "tool."]
+            .iter()
+            .any(|s| k.starts_with(s))
+    }) {
+        return Err(VerneError::Usage(format!(
+            "--sweep {key}: the workspace depends on the keys of [module], [limits], [table] and [tool] only"
+        )));
+    }
     let points = crate::arg_values::sweep_points(&args.sweep);
     let base = machine.to_toml();
     let resolve = |_: &str| -> Result<(String, String), String> {
@@ -74,10 +83,20 @@ fn run_sweep(
             .map(|(k, v)| format!("{k}={v}"))
             .collect::<Vec<_>>()
             .join(", ");
-        let m = verne::spec::Machine::from_str_on_base(
-            &text,
-            &format!("--sweep {label}"),
-            Some(&resolve),
+        // The problems are the swept values' own: named by the value, not by a line of the
+        // text the sweep wrote.
+        let m = verne::spec::Machine::from_str_on_base(&text, "--sweep", Some(&resolve)).map_err(
+            |e| {
+                let problems: Vec<String> = e
+                    .problems
+                    .iter()
+                    .map(|p| format!("{}: {}", p.key, p.message))
+                    .collect();
+                VerneError::Usage(format!(
+                    "--sweep {label}: not a valid machine: {}",
+                    problems.join("; ")
+                ))
+            },
         )?;
         machines.push(m);
     }
@@ -301,6 +320,28 @@ fn run_adaptive(
 }
 
 pub fn run(args: &WorkspaceArgs) -> Result<u8, VerneError> {
+    // Every output of the run, pictures of several tool lengths included, a file of its own.
+    let mut outputs: Vec<(String, PathBuf)> = Vec::new();
+    if let Some(o) = &args.output {
+        outputs.push(("-o".into(), o.clone()));
+    }
+    if let Some(p) = &args.plot {
+        if args.tool_length.len() > 1 && args.sweep.is_empty() {
+            for &l in &args.tool_length {
+                outputs.push((
+                    format!("--plot (tool length {l})"),
+                    plot_path(p, &args.tool_length, l),
+                ));
+            }
+        } else {
+            outputs.push(("--plot".into(), p.clone()));
+        }
+    }
+    let named: Vec<(&str, &Path)> = outputs
+        .iter()
+        .map(|(o, p)| (o.as_str(), p.as_path()))
+        .collect();
+    crate::files::check_distinct_outputs(&named)?;
     if let Some(spec) = super::glider::load(args.common.machine.as_deref())? {
         // The options of the VERNE machine's workspace have no meaning for a planar glider:
         // refused, not ignored.
@@ -480,7 +521,7 @@ pub fn run(args: &WorkspaceArgs) -> Result<u8, VerneError> {
             let title = format!(
                 "{} workspace{}, step {} mm, {} ({}): {:.1} l",
                 of.name(),
-                tool.map(|t| format!(", tool length {t} mm"))
+                tool.map(|t| format!(", tool length {} mm", fmt_num(t, 6)))
                     .unwrap_or_default(),
                 step,
                 machine.name,
@@ -591,7 +632,12 @@ fn plot_path(p: &Path, lengths: &[f64], l: f64) -> PathBuf {
     p.with_file_name(format!("{stem}-L{}.{ext}", fmt_num(l, 3)))
 }
 
+/// A number with at most `decimals` decimals for a title or a file name; in exponent form from
+/// 1e9 on (a number of 309 digits is no name).
 fn fmt_num(v: f64, decimals: usize) -> String {
+    if v.abs() >= 1e9 {
+        return format!("{v:e}");
+    }
     let s = format!("{v:.decimals$}");
     let s = if s.contains('.') {
         s.trim_end_matches('0').trim_end_matches('.').to_string()

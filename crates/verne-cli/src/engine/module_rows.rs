@@ -351,8 +351,9 @@ impl RowJob for ModuleFkWorking {
 mod tests {
     use super::*;
     use crate::engine::pipeline::{self, Units};
+    use crate::files::Sink;
+    use crate::table::CsvSource;
     use crate::table::tests::SharedBuf;
-    use crate::table::{CsvSource, Sink};
     use verne::details::lcg;
 
     /// What `verne ik` and `verne fk` did before [`Working`]: every branch kept per row, the

@@ -10,9 +10,8 @@ use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use crate::error::VerneError;
-use crate::table::{
-    CellError, CsvSource, Sink, TableRow, encode_field, format_number, parse_number,
-};
+use crate::files::Sink;
+use crate::table::{CellError, CsvSource, TableRow, encode_field, format_number, parse_number};
 use verne::error::shown;
 use verne::parallel_module::branches::Verdict;
 

@@ -1,5 +1,5 @@
 //! `verne ik` on a toolpath: typed rows from a reader ([`crate::toolpath`]) to a writer
-//! ([`write`]), through the machine's inverse kinematics along the path. Rows go through in
+//! ([`mod@write`]), through the machine's inverse kinematics along the path. Rows go through in
 //! batches on the core's row engine ([`verne::stream::run_batches`]): while one batch is read,
 //! the one before is solved (every branch of each row in parallel, then the branch chosen in
 //! order, nearest the previous row) and the one before that is written.
@@ -350,14 +350,14 @@ impl Follower {
         }
         let status = status_text(f.status());
         if let Some(what) = every_row {
-            return Err(VerneError::input(
+            return Err(VerneError::RowFailed(Box::new(VerneError::input(
                 file,
                 Some(f.row.line),
                 None,
                 format!(
-                    "row status `{status}`: {what} cannot leave out a row; fix the path or use CSV output to see every row's status"
+                    "row status `{status}`: {what} cannot leave out a row; fix the path or use CSV output to see every row's status (exit 1)"
                 ),
-            ));
+            ))));
         }
         self.summary.count(&status, f.row.line);
         Ok(())

@@ -283,7 +283,7 @@ impl<'a> Post<'a> {
                     self.report.timed_blocks += 1;
                     self.report.time_s += t;
                     self.report.feed_time_s += block.min_time;
-                    if t > block.min_time * (1.0 + 1e-6) {
+                    if t > block.min_time * (1.0 + 1e-6) && moves(&block) {
                         self.report.slowed += 1;
                     }
                     self.recent.push((self.released, w.row.row.line, block, t));
@@ -311,7 +311,7 @@ impl<'a> Post<'a> {
             let times: Vec<f64> = self.recent.iter().take(2).map(|r| r.3).collect();
             let (n, line, block, t) = self.recent[0];
             let (limit, share) = limiting(&blocks, &times, 0, &limits);
-            if t > block.min_time * (1.0 + 1e-6) {
+            if t > block.min_time * (1.0 + 1e-6) && moves(&block) {
                 lines.push(ScheduleLine {
                     block: n,
                     line,
@@ -324,6 +324,12 @@ impl<'a> Post<'a> {
             self.recent.remove(0);
         }
     }
+}
+
+/// False for a block that moves no joint (a repeated pose): it takes the schedule's still time,
+/// which no drive's limit sets.
+fn moves(block: &BlockMove) -> bool {
+    block.dq.iter().any(|d| *d != 0.0)
 }
 
 /// The row of a pose inserted on the move to `to`: the move's line, feed and tool, the intended

@@ -12,7 +12,8 @@ use verne::spec::gcode::GcodeWords;
 use super::{Followed, RowResult, RowSink};
 use crate::engine::pipeline::{Cell, HALSTREAMER_COLUMNS, Units, write_cell};
 use crate::error::VerneError;
-use crate::table::{Sink, encode_field};
+use crate::files::Sink;
+use crate::table::encode_field;
 use crate::toolpath::{Column, PoseRow, Value};
 
 /// The computed columns of a path followed on one branch.

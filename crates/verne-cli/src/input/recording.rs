@@ -69,16 +69,22 @@ pub struct RecordingReader {
     line: u64,
     index: u64,
     buf: Vec<u8>,
+    /// The last sample number read (`tag`).
+    last_tag: Option<f64>,
 }
 
 impl RecordingReader {
     /// Opens `path` (`-`: stdin).
     pub fn open(path: &Path, columns: Vec<Column>, period: f64) -> Result<Self, VerneError> {
-        let name = path.display().to_string();
+        let name = if path.as_os_str() == "-" {
+            "<stdin>".to_string()
+        } else {
+            path.display().to_string()
+        };
         let input: Box<dyn BufRead + Send> = if path.as_os_str() == "-" {
             Box::new(std::io::BufReader::new(std::io::stdin()))
         } else {
-            let f = crate::table::open_input_file(path).map_err(|e| VerneError::io(&name, e))?;
+            let f = crate::files::open_input_file(path).map_err(|e| VerneError::io(&name, e))?;
             Box::new(std::io::BufReader::with_capacity(64 * 1024, f))
         };
         Ok(Self::from_reader(input, &name, columns, period))
@@ -99,6 +105,7 @@ impl RecordingReader {
             line: 0,
             index: 0,
             buf: Vec::new(),
+            last_tag: None,
         }
     }
 
@@ -214,6 +221,26 @@ impl RowSource for RecordingReader {
             }
             if let Some(e) = bad {
                 return Ok(Some(item(Err(e))));
+            }
+            // A tag is halsampler's sample number: an integer, each above the one before.
+            if let Some(v) = tag {
+                if v.fract() != 0.0 || !(0.0..=9.007e15).contains(&v) {
+                    return Err(self.error(
+                        Some("tag"),
+                        format!("expected a sample number (a whole number from 0), found {v}"),
+                    ));
+                }
+                if let Some(last) = self.last_tag
+                    && v <= last
+                {
+                    return Err(self.error(
+                        Some("tag"),
+                        format!(
+                            "sample number {v} does not follow {last}: the tags of a recording increase"
+                        ),
+                    ));
+                }
+                self.last_tag = Some(v);
             }
             let t = tag.unwrap_or((self.index - 1) as f64) * self.period;
             return Ok(Some(item(Ok(Joints {

@@ -78,7 +78,7 @@ fn io_err(_path: &Path, e: impl std::fmt::Display) -> String {
 pub fn check_picture_path(path: &Path) -> Result<(), crate::error::VerneError> {
     use crate::error::VerneError;
     Format::of_path(path).map_err(VerneError::Usage)?;
-    crate::table::check_output_path(path)
+    crate::files::check_output_path(path)
         .map_err(|e| VerneError::io(&path.display().to_string(), e))
 }
 
@@ -87,8 +87,8 @@ macro_rules! render {
     ($path:expr, $size:expr, $draw:expr) => {{
         let path: &Path = $path;
         register_font();
-        // A device or a FIFO is written in place (see `table::output_destination`).
-        let dest = crate::table::output_destination(path);
+        // A device or a FIFO is written in place (see `files::output_destination`).
+        let dest = crate::files::output_destination(path);
         match Format::of_path(path)
             .map_err(|_| String::from("a picture file must end in .svg or .png"))?
         {
@@ -99,20 +99,20 @@ macro_rules! render {
                     $draw(&root)?;
                     root.present().map_err(|e| io_err(path, e))?;
                 }
-                crate::table::write_output(path, text.as_bytes()).map_err(|e| io_err(path, e))
+                crate::files::write_output(path, text.as_bytes()).map_err(|e| io_err(path, e))
             }
             Format::Png => {
                 // The bitmap encoder picks the format from the extension: keep it.
                 let tmp = if dest.in_place {
                     dest.path.clone()
                 } else {
-                    crate::table::remove_stale_temps(&dest.path);
+                    crate::files::remove_stale_temps(&dest.path);
                     let ext = dest
                         .path
                         .extension()
                         .map(|e| format!(".{}", e.to_string_lossy()))
                         .unwrap_or_default();
-                    crate::table::temp_path_for(&dest.path, &ext)
+                    crate::files::temp_path_for(&dest.path, &ext)
                 };
                 let drawn = (|| -> Result<(), String> {
                     let root = BitMapBackend::new(&tmp, $size).into_drawing_area();

@@ -29,9 +29,9 @@ pub fn help_text() -> String {
         );
     }
     s.push_str(
-        "\nReport columns: row,check,value,limit,detail (docs/verify.md).\n\n\
+        "\nReport columns: row,check,value,limit,detail,joints_line,path_line (docs/verify.md).\n\n\
          Exit codes: 0 every check passed, 1 some check failed, 2 fatal (bad arguments,\n\
-         unreadable or malformed input, row counts differ without ids).",
+         unreadable or malformed input, an id given twice).",
     );
     s
 }
@@ -75,7 +75,7 @@ pub fn summary_text(summary: &Summary) -> String {
                     rounded_number(w.value, 6),
                     rounded_number(w.limit, 6),
                     w.row,
-                    w.detail
+                    with_lines(w)
                 );
             }
         }
@@ -102,21 +102,62 @@ pub fn summary_json(summary: &Summary) -> String {
         }
         let _ = write!(s, "\"{}\":{{\"count\":{}", c.code(), st.count);
         match &st.worst {
-            None => s.push_str(",\"worst\":null,\"limit\":null,\"row\":null,\"detail\":null}"),
+            None => s.push_str(
+                ",\"worst\":null,\"limit\":null,\"row\":null,\"detail\":null,\"joints_line\":null,\"path_line\":null}",
+            ),
             Some(w) => {
+                let line = |l: Option<u64>| l.map_or("null".to_string(), |l| l.to_string());
                 let _ = write!(
                     s,
-                    ",\"worst\":{},\"limit\":{},\"row\":{},\"detail\":{}}}",
+                    ",\"worst\":{},\"limit\":{},\"row\":{},\"detail\":{},\"joints_line\":{},\"path_line\":{}}}",
                     json_number(w.value),
                     json_number(w.limit),
                     json_string(&w.row),
-                    json_string(&w.detail)
+                    json_string(&w.detail),
+                    line(w.joints_line),
+                    line(w.path_line)
                 );
             }
         }
     }
     s.push_str("}}");
     s
+}
+
+/// A finding's detail with the lines of both inputs it is at.
+fn with_lines(w: &verne::verify::Violation) -> String {
+    match (w.joints_line, w.path_line) {
+        (Some(j), Some(p)) => format!("{} [joints line {j}, path line {p}]", w.detail),
+        (Some(j), None) => format!("{} [joints line {j}]", w.detail),
+        (None, Some(p)) => format!("{} [path line {p}]", w.detail),
+        (None, None) => w.detail.clone(),
+    }
+}
+
+/// A fatal error as the JSON object `--format json` writes instead of a summary: the file, line
+/// and column when the error has them, and the message.
+pub fn error_json(e: &crate::error::VerneError) -> String {
+    use crate::error::VerneError;
+    if let VerneError::RowFailed(inner) = e {
+        return error_json(inner);
+    }
+    let (file, line, column, message) = match e {
+        VerneError::Input {
+            file,
+            line,
+            column,
+            message,
+        } => (Some(file.clone()), *line, column.clone(), message.clone()),
+        VerneError::Io { file, error } => (Some(file.clone()), None, None, error.to_string()),
+        other => (None, None, None, other.to_string()),
+    };
+    format!(
+        "{{\"error\":{},\"file\":{},\"line\":{},\"column\":{}}}",
+        json_string(&message),
+        file.as_deref().map_or("null".to_string(), json_string),
+        line.map_or("null".to_string(), |l| l.to_string()),
+        column.as_deref().map_or("null".to_string(), json_string)
+    )
 }
 
 /// A number rounded to 9 significant digits in its shortest form; empty for NaN.

@@ -80,7 +80,7 @@ impl Input {
         let known = force.or(by_name.filter(|f| allowed.contains(f)));
         let mut opened = match file {
             Some(p) => {
-                let f = crate::table::open_input_file(p).map_err(io)?;
+                let f = crate::files::open_input_file(p).map_err(io)?;
                 let regular = f.metadata().is_ok_and(|m| m.is_file());
                 let reader = BufReader::with_capacity(READ_BUFFER, f);
                 if regular {

@@ -183,6 +183,15 @@ pub fn continue_locally(
     if !finite {
         return Err(Fallback::NotFinite);
     }
+    if m.has_zeros() {
+        // The previous joints as the equations' variables, the answer as the joints read it.
+        let model_prev = PreviousJoints {
+            rho: m.model_sliders(&prev.rho),
+            theta1: prev.theta1 + m.table.theta_zero[0],
+        };
+        return continue_locally(&m.model(), pose, tool_length, &model_prev)
+            .map(|b| super::ik::joints_of_branch(m, &b));
+    }
     let g = &m.module;
     let (sin_phi1, cos_phi1) = pose.phi1.sin_cos();
     let path = Leg1Path {

@@ -90,8 +90,9 @@ pub type MachineIkBranches = Certified<MachineIkBranch, MAX_MACHINE_IK_BRANCHES>
 /// rounding, so a posture farther than this is some other root's.
 const ROOT_POLISH_RAD: f64 = 1e-6;
 
-/// The platform point in the frame that follows the tilting axis, w = trans(z, d_t) rot(x, pi)
-/// rot(z, -phi2) (U + Delta a): constant in theta1 (eqs. (7)-(9), AIM 2007).
+/// The platform point in the frame that follows the tilting axis, w = trans(y, y_t) trans(z, d_t)
+/// rot(x, pi) rot(z, -phi2) (U + Delta a): constant in theta1 (eqs. (7)-(9), AIM 2007; y_t = 0
+/// in the paper).
 pub(crate) fn tilt_frame_platform(
     table: &TableGeometry,
     pose: &ToolPose,
@@ -115,7 +116,7 @@ pub(super) fn tilt_frame_platform_sc(
         -s2 * u.x + c2 * u.y - tool_length * s1,
         u.z + tool_length * c1,
     );
-    Vector3::new(q.x, -q.y, table.d_t - q.z)
+    Vector3::new(q.x, table.y_t - q.y, table.d_t - q.z)
 }
 
 /// P(theta1) = trans(z, d_a) rot(x, theta1) w, and its derivative in theta1, from
@@ -403,6 +404,19 @@ pub(super) fn posture_branches_each(
     }
 }
 
+/// A branch of [`Machine::model`] as `m`'s joints read it: the sliders less their zero offsets,
+/// the table's angles less theirs (wrapped to (-pi, pi]); the one place the machine's inverse
+/// kinematics leaves the equations' variables.
+pub(crate) fn joints_of_branch(m: &Machine, b: &MachineIkBranch) -> MachineIkBranch {
+    let [z1, z2] = m.table.theta_zero;
+    MachineIkBranch {
+        rho: m.joint_sliders(&b.rho),
+        theta1: wrap_angle(b.theta1 - z1),
+        theta2: wrap_angle(b.theta2 - z2),
+        ..*b
+    }
+}
+
 /// Every real inverse-kinematics branch of the machine for a tool pose in R_t (AIM 2007, section
 /// III.C), ordered by theta1 then by (s1, s2, s3). theta2 = -phi2 wrapped to (-pi, pi]. Empty
 /// when the pose is unreachable by any real branch (never because of a convergence failure: the
@@ -421,6 +435,20 @@ pub fn machine_ik_into(
     tool_length: f64,
     out: &mut MachineIkBranches,
 ) {
+    if m.has_zeros() {
+        // Solved on the equations' variables, then given as the joints read them.
+        machine_ik_into(&m.model(), pose, tool_length, out);
+        for b in out.iter_mut() {
+            *b = joints_of_branch(m, b);
+        }
+        if !out
+            .windows(2)
+            .all(|w| listed_in_order((w[0].theta1, w[0].config), (w[1].theta1, w[1].config)))
+        {
+            out.sort_by(|a, b| a.theta1.total_cmp(&b.theta1).then(a.config.cmp(&b.config)));
+        }
+        return;
+    }
     out.reset();
     let mut certificate = Certificate::Double;
     let finite = pose.tip.iter().all(|v| v.is_finite())

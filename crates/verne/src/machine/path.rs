@@ -130,10 +130,11 @@ struct Candidate {
     theta2: f64,
 }
 
-/// The rotary axis of tool angles: theta2 = -phi2 in (-pi, pi] (AIM 2007 eq. (8)); `+ 0.0` so
-/// that phi2 = 0, the table normal as a program states it, gives theta2 = 0, not -0.
-fn theta2_of(angles: &ToolAngles) -> f64 {
-    wrap_angle(-angles.phi2) + 0.0
+/// The rotary axis of tool angles: theta2 = -phi2 in (-pi, pi] (AIM 2007 eq. (8)) less the
+/// rotary axis's zero offset `zero` (the joint's angle); `+ 0.0` so that phi2 = 0, the table
+/// normal as a program states it, gives theta2 = 0, not -0.
+fn theta2_of(angles: &ToolAngles, zero: f64) -> f64 {
+    wrap_angle(-angles.phi2 - zero) + 0.0
 }
 
 /// theta2 + 2 k pi nearest `reference`.
@@ -151,6 +152,8 @@ pub struct PathCandidates {
     needs_previous: bool,
     /// The weakest certificate of the orientation solutions' branch lists.
     pub certificate: Certificate,
+    /// The rotary axis's zero offset of the machine the candidates are of (rad).
+    theta2_zero: f64,
 }
 
 impl PathCandidates {
@@ -205,6 +208,7 @@ pub fn path_candidates_into(
     out.near_singular = false;
     out.needs_previous = false;
     out.certificate = Certificate::Double;
+    out.theta2_zero = m.table.theta_zero[1];
     match orientation {
         ToolOrientation::Angles(a) => {
             out.near_singular =
@@ -220,7 +224,8 @@ pub fn path_candidates_into(
                 let a = unit_axis(v).map_err(PathError::Axis)?;
                 out.near_singular = true;
                 out.needs_previous = true;
-                let phi2 = -prev_theta2.unwrap_or(0.0);
+                // The previous row's joint plus the rotary axis's zero is the equations' angle.
+                let phi2 = -prev_theta2.unwrap_or(0.0) - out.theta2_zero;
                 out.options.push((
                     ToolAngles {
                         phi1: phi1_at(&a, phi2),
@@ -245,7 +250,7 @@ pub fn path_candidates_into(
                 branch,
                 angles,
                 orientation: label,
-                theta2: theta2_of(&angles),
+                theta2: theta2_of(&angles, out.theta2_zero),
             });
         }
     }
@@ -309,7 +314,7 @@ impl PathState {
         let unwrapped: ArrayVec<(u8, f64), 2> = options
             .iter()
             .map(|&(angles, label)| {
-                let t = theta2_of(&angles);
+                let t = theta2_of(&angles, candidates.theta2_zero);
                 (
                     label,
                     self.reference_theta2().map_or(t, |r| unwrap_near(t, r)),

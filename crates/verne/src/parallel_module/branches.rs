@@ -18,10 +18,12 @@ pub const WORKING_CONFIG: Config = [-1, -1, -1];
 pub fn config_of(g: &crate::spec::ModuleGeometry, pose: &ModulePose, rho: &Sliders) -> Config {
     let s = pose.alpha.sin() * g.r_big2;
     let sign = |q: f64| if q > CONFIG_SIGN_MM { 1 } else { -1 };
+    // The equations' sliders: the joints' plus their zero offsets.
+    let [z1, z2, z3] = g.rho_zero;
     [
-        sign(rho.x - pose.p.z),
-        sign(rho.y - pose.p.z + s),
-        sign(rho.z - pose.p.z - s),
+        sign(rho.x + z1 - pose.p.z),
+        sign(rho.y + z2 - pose.p.z + s),
+        sign(rho.z + z3 - pose.p.z - s),
     ]
 }
 
@@ -206,6 +208,9 @@ pub fn leg_state(
     let g = &m.module;
     let too_tilted =
         |r: nalgebra::Vector3<f64>| rod_too_tilted(r.z, r.norm_squared(), cos_tilt_max);
+    // The stroke is the joint's; the rods see the equations' slider (plus its zero offset).
+    let joint = rho_i;
+    let rho_i = rho_i + g.rho_zero[leg];
     let (q, tilted) = match leg {
         0 => {
             let (dy, dz) = (g.r_big1 * c - g.r_small1, g.r_big1 * s);
@@ -235,7 +240,7 @@ pub fn leg_state(
         leg,
         q,
         tilted,
-        outside_stroke: outside_stroke(m, leg, rho_i),
+        outside_stroke: outside_stroke(m, leg, joint),
     }
 }
 

@@ -20,10 +20,10 @@
 
 use nalgebra::Matrix4;
 
-use crate::math::interval::Iv;
+use crate::math::interval::{Iv, next_up, point_dot};
 use crate::spec::ModuleGeometry;
 
-use super::equations::{ModulePose, Sliders, jacobian_pose};
+use super::equations::{ModulePose, Sliders, jacobian_pose, jacobian_sliders};
 
 /// The pose and its rate over an interval of s, certified.
 #[derive(Debug, Clone, Copy)]
@@ -44,19 +44,33 @@ const BOX_SLACK_MM: f64 = 1e-6;
 /// The rod vectors of eqs. (3)-(6) over intervals: pose (x, y, z, alpha) and sliders.
 fn rod_vectors(g: &ModuleGeometry, x: &[Iv; 4], rho: &[Iv; 3]) -> [[Iv; 3]; 4] {
     let (s, c) = x[3].sin_cos();
+    rod_vectors_sc(g, x, rho, s, c)
+}
+
+/// [`rod_vectors`] from (sin alpha, cos alpha).
+fn rod_vectors_sc(g: &ModuleGeometry, x: &[Iv; 4], rho: &[Iv; 3], s: Iv, c: Iv) -> [[Iv; 3]; 4] {
     let k = Iv::point;
     let (r1, rs1, r2, r4) = (k(g.r_big1), k(g.r_small1), k(g.r_big2), k(g.r4));
+    // The joints' sliders plus their zero offsets are the equations' (equations::rod_vectors);
+    // a zero offset of 0 leaves the interval as it is.
+    let eq = |i: usize| {
+        if g.rho_zero[i] == 0.0 {
+            rho[i]
+        } else {
+            rho[i] + k(g.rho_zero[i])
+        }
+    };
+    let (q1, q2, q3) = (eq(0), eq(1), eq(2));
     [
-        [x[0] + k(g.dx1), x[1] + r1 * c - rs1, x[2] + r1 * s - rho[0]],
-        [x[0] + k(g.dx1), x[1] - r1 * c + rs1, x[2] - r1 * s - rho[0]],
-        [x[0] + k(g.dx2), x[1] - r2 * c + r4, x[2] - r2 * s - rho[1]],
-        [x[0] + k(g.dx2), x[1] + r2 * c - r4, x[2] + r2 * s - rho[2]],
+        [x[0] + k(g.dx1), x[1] + r1 * c - rs1, x[2] + r1 * s - q1],
+        [x[0] + k(g.dx1), x[1] - r1 * c + rs1, x[2] - r1 * s - q1],
+        [x[0] + k(g.dx2), x[1] - r2 * c + r4, x[2] - r2 * s - q2],
+        [x[0] + k(g.dx2), x[1] + r2 * c - r4, x[2] + r2 * s - q3],
     ]
 }
 
 /// d(rod vector)/d alpha of each rod (the sign pattern of [`rod_vectors`]).
-fn rod_vectors_d_alpha(g: &ModuleGeometry, alpha: Iv) -> [[Iv; 2]; 4] {
-    let (s, c) = alpha.sin_cos();
+fn rod_vectors_d_alpha(g: &ModuleGeometry, s: Iv, c: Iv) -> [[Iv; 2]; 4] {
     let (r1, r2) = (Iv::point(g.r_big1), Iv::point(g.r_big2));
     [
         [-(r1 * s), r1 * c],
@@ -79,8 +93,9 @@ fn residuals(g: &ModuleGeometry, x: &[Iv; 4], rho: &[Iv; 3]) -> [Iv; 4] {
 
 /// The parallel Jacobian A in the scaled unknowns (x, y, z, R2 alpha).
 fn jacobian(g: &ModuleGeometry, x: &[Iv; 4], rho: &[Iv; 3], scale: f64) -> [[Iv; 4]; 4] {
-    let v = rod_vectors(g, x, rho);
-    let dv = rod_vectors_d_alpha(g, x[3]);
+    let (s, c) = x[3].sin_cos();
+    let v = rod_vectors_sc(g, x, rho, s, c);
+    let dv = rod_vectors_d_alpha(g, s, c);
     let two = Iv::point(2.0);
     let inv_scale = Iv::point(1.0 / scale);
     std::array::from_fn(|i| {
@@ -106,19 +121,21 @@ fn slider_rate(g: &ModuleGeometry, x: &[Iv; 4], rho: &[Iv; 3], drho: &Sliders) -
     ]
 }
 
+/// Row `i` of C.
+fn row(c: &Matrix4<f64>, i: usize) -> [f64; 4] {
+    std::array::from_fn(|j| c[(i, j)])
+}
+
 /// C times an interval vector.
 fn mul_point(c: &Matrix4<f64>, v: &[Iv; 4]) -> [Iv; 4] {
-    std::array::from_fn(|i| (0..4).fold(Iv::point(0.0), |acc, j| acc + Iv::point(c[(i, j)]) * v[j]))
+    std::array::from_fn(|i| point_dot(&row(c, i), v))
 }
 
 /// C times an interval matrix.
 fn mul_point_matrix(c: &Matrix4<f64>, a: &[[Iv; 4]; 4]) -> [[Iv; 4]; 4] {
     std::array::from_fn(|i| {
-        std::array::from_fn(|j| {
-            (0..4).fold(Iv::point(0.0), |acc, k| {
-                acc + Iv::point(c[(i, k)]) * a[k][j]
-            })
-        })
+        let ci = row(c, i);
+        std::array::from_fn(|j| point_dot(&ci, &std::array::from_fn(|k| a[k][j])))
     })
 }
 
@@ -129,8 +146,13 @@ fn identity_minus(m: &[[Iv; 4]; 4]) -> [[Iv; 4]; 4] {
     })
 }
 
-fn mat_vec(m: &[[Iv; 4]; 4], v: &[Iv; 4]) -> [Iv; 4] {
-    std::array::from_fn(|i| (0..4).fold(Iv::point(0.0), |acc, j| acc + m[i][j] * v[j]))
+/// M times the box [-r, r]: row i is +-(sum of |M_ij| r_j), rounded up.
+fn mul_symmetric(m: &[[Iv; 4]; 4], r: &[f64; 4]) -> [Iv; 4] {
+    std::array::from_fn(|i| {
+        let sum: f64 = (0..4).map(|j| m[i][j].mag() * r[j]).sum();
+        let bound = next_up(sum * (1.0 + 8.0 * f64::EPSILON));
+        Iv::new(-bound, bound)
+    })
 }
 
 /// Encloses the platform's pose and its rate for every s of `s` (within [0, 1]) along the slider
@@ -144,6 +166,71 @@ pub fn enclose_segment(
     s: Iv,
     mid: &ModulePose,
 ) -> Option<SegmentEnclosure> {
+    let kr = krawczyk(g, rho_a, rho_b, s, mid)?;
+    let rate = rate_over(g, &kr)?;
+    Some(SegmentEnclosure {
+        pose: kr.unscaled(&kr.k),
+        rate: kr.unscaled(&rate),
+    })
+}
+
+/// [`enclose_segment`], and the pose at the middle of `s` enclosed tightly (the same proof at
+/// the point: its E = I - C A over the larger box holds over the smaller one too).
+pub fn enclose_segment_and_middle(
+    g: &ModuleGeometry,
+    rho_a: &Sliders,
+    rho_b: &Sliders,
+    s: Iv,
+    mid: &ModulePose,
+) -> Option<(SegmentEnclosure, [Iv; 4])> {
+    let kr = krawczyk(g, rho_a, rho_b, s, mid)?;
+    let rate = rate_over(g, &kr)?;
+    // At s_m: K = x - C f(x, rho(s_m)) + E (X_m - x), X_m a box of radius BOX_SLACK_MM.
+    let sm = s.mid();
+    let rho_m: [Iv; 3] = std::array::from_fn(|k| Iv::point(rho_a[k] + sm * kr.drho[k]));
+    let xm = [mid.p.x, mid.p.y, mid.p.z, mid.alpha * kr.scale];
+    let point: [Iv; 4] = std::array::from_fn(|k| Iv::point(xm[k]));
+    let f = mul_point(&kr.c, &residuals(g, &kr.unscaled(&point), &rho_m));
+    let eo = mul_symmetric(&kr.e, &[BOX_SLACK_MM; 4]);
+    let k: [Iv; 4] = std::array::from_fn(|i| point[i] - f[i] + eo[i]);
+    let inside = (0..4).all(|i| k[i].lo > xm[i] - BOX_SLACK_MM && k[i].hi < xm[i] + BOX_SLACK_MM);
+    inside.then(|| {
+        (
+            SegmentEnclosure {
+                pose: kr.unscaled(&kr.k),
+                rate: kr.unscaled(&rate),
+            },
+            kr.unscaled(&k),
+        )
+    })
+}
+
+/// A Krawczyk proof that went through, and what the rate's enclosure reuses of it.
+struct Proof {
+    /// The enclosure K (scaled unknowns).
+    k: [Iv; 4],
+    /// I - C A over the box K lies in (the box holds K, so this holds I - C A(K)).
+    e: [[Iv; 4]; 4],
+    c: Matrix4<f64>,
+    rho: [Iv; 3],
+    drho: Sliders,
+    scale: f64,
+}
+
+impl Proof {
+    fn unscaled(&self, x: &[Iv; 4]) -> [Iv; 4] {
+        [x[0], x[1], x[2], x[3] * Iv::point(1.0 / self.scale)]
+    }
+}
+
+/// Krawczyk's test over `s`, with boxes inflated up to [`INFLATIONS`] times.
+fn krawczyk(
+    g: &ModuleGeometry,
+    rho_a: &Sliders,
+    rho_b: &Sliders,
+    s: Iv,
+    mid: &ModulePose,
+) -> Option<Proof> {
     let scale = g.r_big2;
     let drho = rho_b - rho_a;
     let rho: [Iv; 3] = std::array::from_fn(|k| Iv::point(rho_a[k]) + s * Iv::point(drho[k]));
@@ -159,29 +246,35 @@ pub fn enclose_segment(
     let xm = [mid.p.x, mid.p.y, mid.p.z, mid.alpha * scale];
     let unscaled = |x: &[Iv; 4]| -> [Iv; 4] { [x[0], x[1], x[2], x[3] * Iv::point(1.0 / scale)] };
     let point: [Iv; 4] = std::array::from_fn(|k| Iv::point(xm[k]));
-    // The pose's travel over `s`, from the rate at the middle: the box's first radius.
-    let b_mid = {
-        let p = unscaled(&point);
-        let rho_m: [Iv; 3] = std::array::from_fn(|k| Iv::point(rho_mid[k]));
-        mul_point(&c, &slider_rate(g, &p, &rho_m, &drho))
-    };
     let half = 0.5 * (s.hi - s.lo);
+    // The pose's travel over `s`, from the rate at the middle: the box's first radius.
+    // (A guess, not part of the proof: in floating point.)
+    let travel: [f64; 4] = if half > 0.0 {
+        let b = c * (jacobian_sliders(g, mid, &rho_mid) * drho);
+        std::array::from_fn(|k| 1.25 * b[k].abs() * half)
+    } else {
+        [0.0; 4]
+    };
     let f = mul_point(&c, &residuals(g, &unscaled(&point), &rho));
-    let mut radius: [f64; 4] = std::array::from_fn(|k| 1.25 * b_mid[k].mag() * half + BOX_SLACK_MM);
+    let mut radius: [f64; 4] = std::array::from_fn(|k| travel[k] + BOX_SLACK_MM);
     for _ in 0..INFLATIONS {
         let bx: [Iv; 4] = std::array::from_fn(|k| Iv::new(xm[k] - radius[k], xm[k] + radius[k]));
         let e = identity_minus(&mul_point_matrix(
             &c,
             &jacobian(g, &unscaled(&bx), &rho, scale),
         ));
-        let offset: [Iv; 4] = std::array::from_fn(|k| bx[k] - point[k]);
-        let eo = mat_vec(&e, &offset);
+        let offset: [f64; 4] = std::array::from_fn(|k| (bx[k] - point[k]).mag());
+        let eo = mul_symmetric(&e, &offset);
         let k: [Iv; 4] = std::array::from_fn(|i| point[i] - f[i] + eo[i]);
         let inside = (0..4).all(|i| k[i].lo > bx[i].lo && k[i].hi < bx[i].hi);
         if inside {
-            return rate_over(g, &c, &k, &rho, &drho, scale).map(|rate| SegmentEnclosure {
-                pose: unscaled(&k),
-                rate: unscaled(&rate),
+            return Some(Proof {
+                k,
+                e,
+                c,
+                rho,
+                drho,
+                scale,
             });
         }
         for (r, ki) in radius.iter_mut().zip(&k) {
@@ -192,19 +285,14 @@ pub fn enclose_segment(
     None
 }
 
-/// The rate d pose/ds over the box `k` (scaled unknowns), or `None` when the preconditioned
-/// Jacobian is not close enough to the identity there.
-fn rate_over(
-    g: &ModuleGeometry,
-    c: &Matrix4<f64>,
-    k: &[Iv; 4],
-    rho: &[Iv; 3],
-    drho: &Sliders,
-    scale: f64,
-) -> Option<[Iv; 4]> {
-    let x = [k[0], k[1], k[2], k[3] * Iv::point(1.0 / scale)];
-    let e = identity_minus(&mul_point_matrix(c, &jacobian(g, &x, rho, scale)));
-    let b = mul_point(c, &slider_rate(g, &x, rho, drho));
+/// The rate d pose/ds over the proof's enclosure K (scaled unknowns): every solution of
+/// x' = b + E x' with b = -C B rho' and E = I - C A, both over K (E over K, not over the larger
+/// box of the test: the rate's width is E's width times the rate); `None` when ||E|| is not
+/// below 1.
+fn rate_over(g: &ModuleGeometry, p: &Proof) -> Option<[Iv; 4]> {
+    let x = p.unscaled(&p.k);
+    let e = identity_minus(&mul_point_matrix(&p.c, &jacobian(g, &x, &p.rho, p.scale)));
+    let b = mul_point(&p.c, &slider_rate(g, &x, &p.rho, &p.drho));
     let norm = e
         .iter()
         .map(|row| row.iter().map(|v| v.mag()).sum::<f64>())
@@ -213,9 +301,7 @@ fn rate_over(
         return None;
     }
     let r = b.iter().map(|v| v.mag()).fold(0.0, f64::max) / (1.0 - norm);
-    let r = crate::math::interval::next_up(r);
-    let around = [Iv::new(-r, r); 4];
-    let er = mat_vec(&e, &around);
+    let er = mul_symmetric(&e, &[next_up(r); 4]);
     Some(std::array::from_fn(|i| b[i] + er[i]))
 }
 
@@ -228,7 +314,7 @@ fn point_rate(
     drho: &Sliders,
 ) -> nalgebra::Vector4<f64> {
     let a = jacobian_pose(g, pose, rho);
-    let b = super::equations::jacobian_sliders(g, pose, rho);
+    let b = jacobian_sliders(g, pose, rho);
     -(a.try_inverse().expect("regular") * (b * drho))
 }
 

@@ -17,7 +17,9 @@ pub struct ModulePose {
 pub type Sliders = Vector3<f64>;
 
 /// The four rod vectors B_ij - A_ij of eqs. (3), (4), (5), (6), in that order. Leg I has two
-/// rods (3)-(4); legs II and III are parallelograms, one vector each.
+/// rods (3)-(4); legs II and III are parallelograms, one vector each. `rho` are the joints'
+/// sliders: the geometry's zero offsets ([`ModuleGeometry::rho_zero`]) are added here, the one
+/// place the sliders enter the equations.
 #[inline]
 pub fn rod_vectors(g: &ModuleGeometry, pose: &ModulePose, rho: &Sliders) -> [Vector3<f64>; 4] {
     let (s, c) = pose.alpha.sin_cos();
@@ -34,19 +36,22 @@ fn rod_vectors_sc(
     c: f64,
 ) -> [Vector3<f64>; 4] {
     let (x, y, z) = (pose.p.x, pose.p.y, pose.p.z);
+    // The joints' sliders plus their zero offsets are the equations' rho (0 on Machine::model).
+    let [z1, z2, z3] = g.rho_zero;
+    let (r1, r2, r3) = (rho.x + z1, rho.y + z2, rho.z + z3);
     [
         Vector3::new(
             x + g.dx1,
             y + g.r_big1 * c - g.r_small1,
-            z + g.r_big1 * s - rho.x,
+            z + g.r_big1 * s - r1,
         ),
         Vector3::new(
             x + g.dx1,
             y - g.r_big1 * c + g.r_small1,
-            z - g.r_big1 * s - rho.x,
+            z - g.r_big1 * s - r1,
         ),
-        Vector3::new(x + g.dx2, y - g.r_big2 * c + g.r4, z - g.r_big2 * s - rho.y),
-        Vector3::new(x + g.dx2, y + g.r_big2 * c - g.r4, z + g.r_big2 * s - rho.z),
+        Vector3::new(x + g.dx2, y - g.r_big2 * c + g.r4, z - g.r_big2 * s - r2),
+        Vector3::new(x + g.dx2, y + g.r_big2 * c - g.r4, z + g.r_big2 * s - r3),
     ]
 }
 

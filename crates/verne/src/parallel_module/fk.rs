@@ -157,7 +157,8 @@ impl Elimination {
 }
 
 /// The characteristic trigonometric polynomial F(alpha) of the module documentation for the
-/// slider positions (its real roots are the assembly modes' angles).
+/// slider positions (its real roots are the assembly modes' angles). `rho` are the equations'
+/// sliders ([`Machine::model_sliders`] of the joints): `g`'s zero offsets are not added here.
 pub fn characteristic(g: &ModuleGeometry, rho: &Sliders) -> Trig {
     Elimination::new(g, rho).characteristic(g)
 }
@@ -261,6 +262,10 @@ fn det_zeros(det: &Trig) -> ArrayVec<(f64, f64), 2> {
 /// configuration and verdict. Empty when the sliders cannot be assembled. Built with AVX2 where
 /// the processor has it ([`crate::math::cpu`]).
 pub fn solve(m: &Machine, rho: &Sliders) -> FkModes {
+    // The joints plus the sliders' zero offsets are the equations' sliders: solved on the model.
+    if m.has_zeros() {
+        return solve(&m.model(), &m.model_sliders(rho));
+    }
     #[cfg(target_arch = "x86_64")]
     if cpu::has_avx2() {
         // SAFETY: the processor has AVX2 (checked just above).
@@ -273,6 +278,9 @@ pub fn solve(m: &Machine, rho: &Sliders) -> FkModes {
 /// bit.
 #[doc(hidden)]
 pub fn solve_baseline(m: &Machine, rho: &Sliders) -> FkModes {
+    if m.has_zeros() {
+        return solve_baseline(&m.model(), &m.model_sliders(rho));
+    }
     solve_built::<false>(m, rho)
 }
 
@@ -670,8 +678,8 @@ mod tests {
     /// Sliders whose modes are simple, well-separated roots of F are proved in double
     /// precision alone (no interval left ambiguous for the factors to resolve): Table III of
     /// IFToMM 2007 and the working joints of the two poses off y = 0 above. The pose on y = 0
-    /// has two modes 1.3e-4 rad apart in alpha (the reference document,
-    /// shared/reference/verne-geometry.md): that pair needs the factors.
+    /// has two modes 1.3e-4 rad apart in alpha (docs/reference-results.md): that pair needs the
+    /// factors.
     #[test]
     fn simple_roots_are_proved_in_double_precision() {
         let (m, poses) = poses_and_sliders();

@@ -43,9 +43,10 @@ impl ReachBox {
         };
         for (leg, &(dx, l, r)) in legs.iter().enumerate() {
             within(0, -dx, l.abs());
+            // The equations' strokes: the joints' moved by the sliders' zero offsets.
             let (lo, hi) = (
-                lim.rho_min[leg] - LIMIT_SLACK,
-                lim.rho_max[leg] + LIMIT_SLACK,
+                lim.rho_min[leg] + g.rho_zero[leg] - LIMIT_SLACK,
+                lim.rho_max[leg] + g.rho_zero[leg] + LIMIT_SLACK,
             );
             within(2, 0.5 * (lo + hi), 0.5 * (hi - lo) + r + l.abs());
         }

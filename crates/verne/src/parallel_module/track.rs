@@ -22,7 +22,8 @@ use crate::parallel_module::equations::{
 };
 use crate::parallel_module::fk::{self, FkMode, FkModes};
 use crate::parallel_module::ik::wrap_angle;
-use crate::spec::Machine;
+use crate::spec::{Machine, ModuleGeometry};
+use crate::tolerance::NEWTON_MAX_ITER;
 
 /// Chord iterations before a row goes to the complete solution.
 const MAX_CHORD_STEPS: usize = 8;
@@ -31,6 +32,60 @@ const MAX_CHORD_STEPS: usize = 8;
 const STEP_DONE_MM: f64 = 1e-11;
 /// Fraction of the certified isolation radius 2 / (beta L) a row may move the pose.
 const CERTIFIED_FRACTION: f64 = 0.25;
+
+/// The assembly mode nearest `from` for the sliders `rho` (joints) of the geometry `g`, when it
+/// is certified to be: Newton on eqs. (3)-(6) from `from` converges to q*, and q* moved less
+/// than `CERTIFIED_FRACTION` (1/4) of the isolation radius 2 / (beta L) from `from` (the lemma of
+/// the module documentation, the bounds of [`FkTracker`]), so that no other solution of the
+/// equations is nearer `from`. Also returns A^-1 at q* (A = d(residuals)/d(pose)). For a
+/// caller whose geometry changes between calls (a calibration's steps) as the sliders do along a
+/// path; None when Newton does not converge or the step is not certified.
+pub fn nearest_mode(
+    g: &ModuleGeometry,
+    from: &ModulePose,
+    rho: &Sliders,
+) -> Option<(ModulePose, Matrix4<f64>)> {
+    let radius = g.r_big1.max(g.r_big2);
+    let lipschitz = 4.0 * (3.0 + g.l1.max(g.l2).max(g.l3) / radius);
+    let scaled = |d: &Vector4<f64>| Vector4::new(d[0], d[1], d[2], d[3] * radius).norm();
+    let mut pose = *from;
+    let mut converged = false;
+    for _ in 0..NEWTON_MAX_ITER {
+        let (f, a, _) = residuals_jacobian_sin_cos(g, &pose, rho);
+        let step = a.try_inverse()? * f;
+        if !step.iter().all(|v| v.is_finite()) {
+            return None;
+        }
+        pose.p -= step.xyz();
+        pose.alpha -= step[3];
+        if scaled(&step) < STEP_DONE_MM {
+            converged = true;
+            break;
+        }
+    }
+    if !converged {
+        return None;
+    }
+    let inv = jacobian_pose(g, &pose, rho).try_inverse()?;
+    let beta = Matrix4::from_fn(|i, j| {
+        if i == 3 {
+            inv[(i, j)] * radius
+        } else {
+            inv[(i, j)]
+        }
+    })
+    .norm();
+    let moved = scaled(&Vector4::new(
+        pose.p.x - from.p.x,
+        pose.p.y - from.p.y,
+        pose.p.z - from.p.z,
+        wrap_angle(pose.alpha - from.alpha),
+    ));
+    (moved * beta * lipschitz < 2.0 * CERTIFIED_FRACTION).then(|| {
+        pose.alpha = wrap_angle(pose.alpha);
+        (pose, inv)
+    })
+}
 
 /// Follows the working mode from row to row; one per run of consecutive rows.
 pub struct FkTracker<'m> {

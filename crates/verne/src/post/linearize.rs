@@ -140,6 +140,10 @@ impl Linearizer<'_> {
             end: vb.module,
             intended: intended.between(va.s, vb.s),
         };
+        // Most blocks of a dense path are within their tolerances as they are: prove that first.
+        if prove_within(&block, tol.tip_mm, tol.axis_rad, 1).is_some() {
+            return Ok(());
+        }
         let mut sampled: f64 = 0.0;
         let mut pose = va.module;
         for s in [0.25, 0.5, 0.75] {

@@ -23,7 +23,7 @@
 //! its end), a forward pass then takes the largest reachable x at every vertex: the time-optimal
 //! profile of the discretized problem. Block k then takes T_k = 2 h_k / (sqrt(x_k) +
 //! sqrt(x_(k+1))). The finite differences agree with the block model to second order;
-//! [`SAFETY`] covers the rest, and a last pass ([`repair`]) lowers the speed of any block the
+//! [`SAFETY`] covers the rest, and a last pass (`repair`) lowers the speed of any block the
 //! block model still finds over a limit, so that the timing holds in the model exactly.
 //!
 //! Streaming, in bounded memory: the backward pass over the blocks read so far assumes rest after

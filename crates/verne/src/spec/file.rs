@@ -168,6 +168,48 @@ const SCHEMA: &[(&str, &str, Check, &str)] = &[
     ),
 ];
 
+/// The optional keys, 0 when absent, so that a file without them is read as before: the
+/// real machine's offsets from its drawing, which `verne calibrate` identifies. (section, key,
+/// check, meaning.)
+const OPTIONAL: &[(&str, &str, Check, &str)] = &[
+    (
+        "zeros",
+        "rho1",
+        Check::Finite,
+        "slider 1 zero offset: the equations' rho1 is the joint's plus this (mm)",
+    ),
+    (
+        "zeros",
+        "rho2",
+        Check::Finite,
+        "slider 2 zero offset: the equations' rho2 is the joint's plus this (mm)",
+    ),
+    (
+        "zeros",
+        "rho3",
+        Check::Finite,
+        "slider 3 zero offset: the equations' rho3 is the joint's plus this (mm)",
+    ),
+    (
+        "zeros",
+        "theta1",
+        Check::AngleDegrees,
+        "tilting axis zero offset: the equations' theta1 is the joint's plus this (degrees)",
+    ),
+    (
+        "zeros",
+        "theta2",
+        Check::AngleDegrees,
+        "rotary axis zero offset: the equations' theta2 is the joint's plus this (degrees)",
+    ),
+    (
+        "table",
+        "y_t",
+        Check::Finite,
+        "table: tilting axis to rotary axis along y of the tilted frame (mm)",
+    ),
+];
+
 const TOP_LEVEL_KEYS: &[&str] = &["kind", "name", "base"];
 
 impl Machine {
@@ -407,6 +449,25 @@ impl Machine {
                 "theta1_max must be greater than theta1_min".into(),
             );
         }
+        for j in 0..3 {
+            let stroke = self.limits.rho_max[j] - self.limits.rho_min[j];
+            let zero = m.rho_zero[j];
+            if zero.abs() > stroke {
+                push(
+                    &format!("zeros.rho{}", j + 1),
+                    format!(
+                        "a zero offset of {zero} mm is larger than slider {}'s stroke ({stroke} mm): a slider's zero is a small correction",
+                        j + 1
+                    ),
+                );
+            }
+        }
+        if self.table.y_t.abs() > MAX_LENGTH_MM {
+            push(
+                "table.y_t",
+                format!("{:e} mm is beyond {MAX_LENGTH_MM:e} mm", self.table.y_t),
+            );
+        }
         out
     }
 
@@ -414,14 +475,16 @@ impl Machine {
     pub fn to_toml(&self) -> String {
         let m = &self.module;
         let l = &self.limits;
-        format!(
-            "kind = \"verne\"\nname = {:?}\n\n[module]\nD1 = {}\nd1 = 0.0\nR1 = {}\nr1 = {}\nL1 = {}\nD2 = {}\nd2 = 0.0\nR2 = {}\nr4 = {}\nL2 = {}\nL3 = {}\n\n[limits]\nrho1_min = {}\nrho1_max = {}\nrho2_min = {}\nrho2_max = {}\nrho3_min = {}\nrho3_max = {}\nrod_tilt_max = {}\ntheta1_min = {}\ntheta1_max = {}\n\n[table]\nd_a = {}\nd_t = {}\n\n[tool]\nlength = {}\n\n{}\n{}",
+        let mut text = format!(
+            "kind = \"verne\"\nname = {:?}\n\n[module]\nD1 = {}\nd1 = {:?}\nR1 = {}\nr1 = {}\nL1 = {}\nD2 = {}\nd2 = {:?}\nR2 = {}\nr4 = {}\nL2 = {}\nL3 = {}\n\n[limits]\nrho1_min = {}\nrho1_max = {}\nrho2_min = {}\nrho2_max = {}\nrho3_min = {}\nrho3_max = {}\nrod_tilt_max = {}\ntheta1_min = {}\ntheta1_max = {}\n\n[table]\nd_a = {}\nd_t = {}\n{}\n[tool]\nlength = {}\n\n{}\n{}",
             self.name,
-            m.dx1,
+            m.dx1 + m.d1,
+            m.d1,
             m.r_big1,
             m.r_small1,
             m.l1,
-            m.dx2,
+            m.dx2 + m.d2,
+            m.d2,
             m.r_big2,
             m.r4,
             m.l2,
@@ -437,10 +500,28 @@ impl Machine {
             l.theta1_max.to_degrees(),
             self.table.d_a,
             self.table.d_t,
+            // The optional keys only when they are not zero: a file without them reads as 0.
+            if self.table.y_t != 0.0 {
+                format!("y_t = {}\n", self.table.y_t)
+            } else {
+                String::new()
+            },
             self.tool_length,
             self.drives.to_toml(),
             self.gcode.to_toml()
-        )
+        );
+        let (rz, tz) = (m.rho_zero, self.table.theta_zero);
+        if self.has_zeros() {
+            text.push_str(&format!(
+                "\n[zeros]\nrho1 = {}\nrho2 = {}\nrho3 = {}\ntheta1 = {}\ntheta2 = {}\n",
+                rz[0],
+                rz[1],
+                rz[2],
+                tz[0].to_degrees(),
+                tz[1].to_degrees()
+            ));
+        }
+        text
     }
 }
 
@@ -570,7 +651,7 @@ fn entries_of(text: &str, source: &str) -> Result<(Vec<Entry>, Vec<Problem>), Ma
 fn check_sections(table: &toml::Table, lines: &TomlLines) -> Vec<Problem> {
     let mut out = Vec::new();
     for section in [
-        "module", "limits", "table", "tool", "drives", "verify", "gcode",
+        "module", "limits", "table", "tool", "drives", "verify", "gcode", "zeros",
     ] {
         if let Some(v) = table.get(section)
             && !v.is_table()
@@ -598,6 +679,11 @@ impl TomlLines {
             if let Some(rest) = t.strip_prefix('[') {
                 // `[module] # a comment`: the name ends at the first `]`.
                 current = rest.split(']').next().unwrap_or("").trim().to_string();
+                // A nested table `[verify.sub]` is the key `sub` of `[verify]`, at this line.
+                if let Some((outer, inner)) = current.rsplit_once('.') {
+                    map.entry((outer.trim().to_string(), inner.trim().to_string()))
+                        .or_insert(i + 1);
+                }
                 continue;
             }
             if t.contains('=') {
@@ -622,6 +708,7 @@ fn finish(
 ) -> Result<Machine, MachineError> {
     let line_of = |key: &str| entries.iter().find(|e| e.key == key).and_then(|e| e.line);
     let mut values = [f64::NAN; SCHEMA.len()];
+    let mut optional = [0.0; OPTIONAL.len()];
     let mut kind_seen = false;
     let mut verify = Vec::new();
     let mut drives = Vec::new();
@@ -699,12 +786,15 @@ fn finish(
             }
             continue;
         }
+        // Required keys first, then the optional ones (their positions after SCHEMA's).
         let Some(pos) = SCHEMA
             .iter()
+            .chain(OPTIONAL)
             .position(|(s, k, _, _)| format!("{s}.{k}") == e.key)
         else {
             let hint = SCHEMA
                 .iter()
+                .chain(OPTIONAL)
                 .map(|(s, k, _, _)| format!("{s}.{k}"))
                 .find(|full| full.eq_ignore_ascii_case(&e.key))
                 .map(|full| format!(" (did you mean `{full}`?)"))
@@ -712,7 +802,12 @@ fn finish(
             let known: Vec<String> = TOP_LEVEL_KEYS
                 .iter()
                 .map(|k| k.to_string())
-                .chain(SCHEMA.iter().map(|(s, k, _, _)| format!("{s}.{k}")))
+                .chain(
+                    SCHEMA
+                        .iter()
+                        .chain(OPTIONAL)
+                        .map(|(s, k, _, _)| format!("{s}.{k}")),
+                )
                 .collect();
             problems.push(Problem {
                 line: e.line,
@@ -721,7 +816,11 @@ fn finish(
             });
             continue;
         };
-        let (_, _, check, meaning) = SCHEMA[pos];
+        let (_, _, check, meaning) = if pos < SCHEMA.len() {
+            SCHEMA[pos]
+        } else {
+            OPTIONAL[pos - SCHEMA.len()]
+        };
         let x = match &e.value {
             Value::Number(x) => *x,
             Value::Text(s) => {
@@ -759,7 +858,11 @@ fn finish(
             });
             continue;
         }
-        values[pos] = x;
+        if pos < SCHEMA.len() {
+            values[pos] = x;
+        } else {
+            optional[pos - SCHEMA.len()] = x;
+        }
     }
     let gcode = GcodeWords::from_entries(&gcode, &mut problems);
     let drives = Drives::from_entries(&drives, &mut problems);
@@ -800,6 +903,9 @@ fn finish(
             r4: v(8),
             l2: v(9),
             l3: v(10),
+            d1: v(1),
+            d2: v(6),
+            rho_zero: [optional[0], optional[1], optional[2]],
         },
         limits: Limits {
             rho_min: [v(11), v(13), v(15)],
@@ -812,6 +918,8 @@ fn finish(
         table: TableGeometry {
             d_a: v(20),
             d_t: v(21),
+            y_t: optional[5],
+            theta_zero: [optional[3].to_radians(), optional[4].to_radians()],
         },
         tool_length: v(22),
         drives,

@@ -72,6 +72,10 @@ impl Default for GcodeWords {
     }
 }
 
+/// The largest offset of a joint's word (mm or degrees): beyond, the word written with six
+/// decimals no longer carries the joint's 1e-6 (a double has 15 to 16 digits).
+pub const MAX_WORD_OFFSET: f64 = 1e8;
+
 /// The joint names of the table's keys, in order.
 pub const JOINT_KEYS: [&str; 5] = ["rho1", "rho2", "rho3", "theta1", "theta2"];
 
@@ -133,7 +137,14 @@ impl GcodeWords {
                 .and_then(|k| JOINT_KEYS.iter().position(|j| *j == k))
             {
                 match number {
-                    Some(x) => g.joints[j].offset = x,
+                    Some(x) if x.abs() <= MAX_WORD_OFFSET => g.joints[j].offset = x,
+                    Some(x) => bad(
+                        *line,
+                        key,
+                        format!(
+                            "{x:e} is beyond {MAX_WORD_OFFSET:e}: the joint's digits would be lost in its word (written with 1e-6 of resolution)"
+                        ),
+                    ),
                     None => bad(
                         *line,
                         key,

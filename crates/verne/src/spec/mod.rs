@@ -7,6 +7,8 @@ pub mod gcode;
 
 pub use file::{BaseResolver, MAX_BASE_DEPTH, MAX_LENGTH_MM};
 
+use crate::parallel_module::equations::Sliders;
+
 /// The embedded default machine (data/verne.toml).
 pub const DEFAULT_MACHINE_TOML: &str = include_str!("../../data/verne.toml");
 
@@ -24,6 +26,15 @@ pub struct ModuleGeometry {
     pub r4: f64,
     pub l2: f64,
     pub l3: f64,
+    /// d1 and d2 as the machine file gives them (mm): only D1 - d1 and D2 - d2 enter the
+    /// equations, so these only say how a file splits them (a calibrated file keeps them).
+    pub d1: f64,
+    pub d2: f64,
+    /// The sliders' zero offsets (mm): the equations' rho_i is the joint's rho_i plus this
+    /// (`[zeros]` of the machine file, 0 by default). Applied where a slider enters the
+    /// constraint equations (3)-(6) ([`crate::parallel_module::equations::rod_vectors`]);
+    /// the solvers run on [`Machine::model`], where it is zero.
+    pub rho_zero: [f64; 3],
 }
 
 /// Joint and passive-joint limits (mm and rad).
@@ -45,6 +56,13 @@ pub struct Limits {
 pub struct TableGeometry {
     pub d_a: f64,
     pub d_t: f64,
+    /// The rotary axis's offset from the tilting axis along y of the tilted frame (mm, 0 by
+    /// default): eq. (7) with trans(y, y_t) next to trans(z, d_t).
+    pub y_t: f64,
+    /// The table axes' zero offsets (rad): the equations' theta1, theta2 are the joints' plus
+    /// these (`[zeros]` of the machine file, 0 by default), applied where the angles enter
+    /// eq. (7) ([`crate::machine::table_transform`], [`crate::machine::tool_pose_eq26`]).
+    pub theta_zero: [f64; 2],
 }
 
 /// A validated VERNE-type machine.
@@ -67,6 +85,59 @@ pub struct Machine {
 }
 
 impl Machine {
+    /// True when a joint zero offset is not zero: the joints the machine's controller reads
+    /// then differ from the equations' variables.
+    pub fn has_zeros(&self) -> bool {
+        self.module.rho_zero.iter().any(|&z| z != 0.0)
+            || self.table.theta_zero.iter().any(|&z| z != 0.0)
+    }
+
+    /// The machine the solvers run on: its joints are the equations' variables (every zero
+    /// offset 0) and its limits are the file's moved by the zero offsets, so that a branch
+    /// within them is within the file's limits. The machine itself when it has no zero offsets;
+    /// otherwise a copy without name or `[verify]` table (nothing to allocate).
+    pub fn model(&self) -> std::borrow::Cow<'_, Machine> {
+        if !self.has_zeros() {
+            return std::borrow::Cow::Borrowed(self);
+        }
+        let (rz, tz) = (self.module.rho_zero, self.table.theta_zero);
+        let mut limits = self.limits;
+        for ((min, max), z) in limits.rho_min.iter_mut().zip(&mut limits.rho_max).zip(rz) {
+            *min += z;
+            *max += z;
+        }
+        limits.theta1_min += tz[0];
+        limits.theta1_max += tz[0];
+        std::borrow::Cow::Owned(Machine {
+            name: String::new(),
+            module: ModuleGeometry {
+                rho_zero: [0.0; 3],
+                ..self.module
+            },
+            limits,
+            table: TableGeometry {
+                theta_zero: [0.0; 2],
+                ..self.table
+            },
+            tool_length: self.tool_length,
+            drives: self.drives,
+            verify: Vec::new(),
+            gcode: self.gcode,
+        })
+    }
+
+    /// Slider positions of the equations (of [`Machine::model`]) as the joints read them.
+    #[inline]
+    pub fn joint_sliders(&self, model: &Sliders) -> Sliders {
+        model - Sliders::from(self.module.rho_zero)
+    }
+
+    /// Joint slider positions as the equations (and [`Machine::model`]) take them.
+    #[inline]
+    pub fn model_sliders(&self, joints: &Sliders) -> Sliders {
+        joints + Sliders::from(self.module.rho_zero)
+    }
+
     /// The embedded VERNE machine.
     pub fn default_verne() -> Machine {
         Machine::from_toml_str(DEFAULT_MACHINE_TOML, "<default>")
@@ -84,6 +155,7 @@ impl Machine {
         m.limits.rho_max = self.limits.rho_max.map(|r| r * k);
         m.table.d_a *= k;
         m.table.d_t *= k;
+        m.table.y_t *= k;
         m.tool_length *= k;
         m
     }
@@ -103,6 +175,9 @@ impl ModuleGeometry {
             r4: self.r4 * k,
             l2: self.l2 * k,
             l3: self.l3 * k,
+            d1: self.d1 * k,
+            d2: self.d2 * k,
+            rho_zero: self.rho_zero.map(|z| z * k),
         }
     }
 }

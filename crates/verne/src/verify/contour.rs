@@ -22,7 +22,7 @@ use nalgebra::{SVector, Vector3};
 
 use super::row::mode_of_kind;
 use super::{
-    Item, JointSource, Joints, Observer, PairingError, PathPoint, RowSource, Summary,
+    Check, Item, JointSource, Joints, Observer, PairingError, PathPoint, RowSource, Summary, Th,
     VerifyOptions, Violation, verify_observed,
 };
 use crate::machine::orientation::{move_angles, tool_axis};
@@ -306,7 +306,18 @@ struct Projected<'a, E> {
     previous: Option<PathPoint>,
     /// The assembly modes of the joint row just projected, for the row check.
     modes: Option<Box<MachineFkModes>>,
+    /// How much of the path the samples covered: the first and the farthest nearest points
+    /// (segment, parameter), and the last sample's.
+    reach: Option<Reach>,
     _error: std::marker::PhantomData<E>,
+}
+
+/// Where the samples of a recording fell on the path.
+#[derive(Debug, Clone, Copy)]
+struct Reach {
+    first: (usize, f64),
+    farthest: (usize, f64),
+    last: (usize, f64),
 }
 
 impl<E> RowSource for Projected<'_, E> {
@@ -341,6 +352,26 @@ impl<E> RowSource for Projected<'_, E> {
             self.path
                 .nearest(&mode.tool.tip, mode.tool.phi1, mode.tool.phi2)
         });
+        if let Some(n) = &nearest {
+            let at = (n.segment, n.u);
+            let later = |a: (usize, f64), b: (usize, f64)| a.0 > b.0 || (a.0 == b.0 && a.1 > b.1);
+            self.reach = Some(match self.reach {
+                None => Reach {
+                    first: at,
+                    farthest: at,
+                    last: at,
+                },
+                Some(r) => Reach {
+                    first: r.first,
+                    farthest: if later(at, r.farthest) {
+                        at
+                    } else {
+                        r.farthest
+                    },
+                    last: at,
+                },
+            });
+        }
         // A row that cannot be solved is reported by the row check; pair it with the last point.
         let point = match (nearest, self.previous) {
             (Some(n), _) => n.point,
@@ -404,9 +435,44 @@ where
         index: 0,
         previous: None,
         modes: None,
+        reach: None,
         _error: std::marker::PhantomData,
     };
-    verify_observed(m, opt, &mut tee, &mut projected, report, observe)
+    let mut summary = verify_observed(m, opt, &mut tee, &mut projected, report, observe)?;
+    // The recording must cover the path, from its first point to its last: its first sample at
+    // the path's start, some sample at its end, and its last sample there.
+    let nodes = &projected.path.nodes;
+    let tol = opt.thresholds.get(Th::TipErrorMm);
+    let along = |(k, u): (usize, f64)| -> f64 {
+        let seg = |i: usize| (nodes[i + 1].tip - nodes[i].tip).norm();
+        (0..k).map(seg).sum::<f64>() + if k + 1 < nodes.len() { u * seg(k) } else { 0.0 }
+    };
+    let total = along((nodes.len().saturating_sub(1), 0.0));
+    let gap = match projected.reach {
+        None => Some("the recording has no sample on the path: it covers nothing".to_string()),
+        Some(r) => {
+            let (start, far, end) = (along(r.first), along(r.farthest), along(r.last));
+            if start > tol {
+                Some(format!(
+                    "the recording starts {start:.4} mm along the path, not at its first point"
+                ))
+            } else if total - far > tol || total - end > tol {
+                Some(format!(
+                    "the recording ends {:.4} mm along the path, {:.4} mm before its last point (it reached {far:.4} mm)",
+                    end,
+                    total - end
+                ))
+            } else {
+                None
+            }
+        }
+    };
+    if let Some(detail) = gap {
+        let v = Violation::plain(&summary.rows.to_string(), Check::Pairing, f64::NAN, detail);
+        summary.add(&v);
+        report(&v)?;
+    }
+    Ok(summary)
 }
 
 #[cfg(test)]

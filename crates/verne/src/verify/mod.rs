@@ -574,6 +574,7 @@ where
         Pairer::Undecided
     };
     let mut last_label = String::new();
+    let mut last_line = 0;
     let mut prev_row: Option<RowEval> = None;
     let mut prev_seg: Option<PrevSeg> = None;
     let mut gap = false;
@@ -649,6 +650,7 @@ where
                 summary.rows += 1;
                 let lines = (row.joints_line, row.path_line);
                 last_label = row.label.clone();
+                last_line = row.joints_line;
                 for o in &row.obs {
                     summary.observe(o, &row.label, lines);
                 }
@@ -820,7 +822,7 @@ where
         }
     }
     for item in rest {
-        let v = missing_row(&item, &last_label);
+        let v = missing_row(&item, &last_label, last_line);
         summary.add(&v);
         report(&v)?;
     }
@@ -866,7 +868,7 @@ fn pose_observation(m: &Machine, opt: &VerifyOptions, r: &RowEval) -> Option<Pos
 }
 
 /// The finding of a path row no joint row was paired with, placed at the joint row `at`.
-fn missing_row(item: &Item<PathPoint>, at: &str) -> Violation {
+fn missing_row(item: &Item<PathPoint>, at: &str, joints_line: u64) -> Violation {
     let what = match &item.id {
         Some(id) => format!("id `{id}` (intended path line {})", item.line),
         None => format!("intended path row {} (line {})", item.index, item.line),
@@ -878,6 +880,7 @@ fn missing_row(item: &Item<PathPoint>, at: &str) -> Violation {
         format!("{what} has no joint row"),
     );
     v.path_line = Some(item.line);
+    v.joints_line = Some(joints_line);
     v
 }
 

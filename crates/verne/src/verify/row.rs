@@ -49,8 +49,11 @@ pub(super) fn eval_row(
     };
     // Path rows the pairing passed over without a joint row of their own.
     for item in &p.missing {
-        e.violations
-            .push(super::missing_row(item, &label_of(&p.joints)));
+        e.violations.push(super::missing_row(
+            item,
+            &label_of(&p.joints),
+            p.joints.line,
+        ));
     }
     let q = match &p.joints.value {
         Ok(q) => *q,

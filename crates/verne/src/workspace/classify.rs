@@ -29,9 +29,9 @@ pub fn tool_tip(p: &Vector3<f64>, alpha: f64, delta: f64) -> Vector3<f64> {
     Vector3::new(p.x, p.y - delta * s, p.z + delta * c)
 }
 
-/// Tool tip in the table frame with theta1 = alpha, theta2 = phi1 = phi2 = 0: eq. (26),
-/// AIM 2007, X_u = xp, Y_u = V1, Z_u = sin(theta1) yp + V2 with
-/// V1 = Delta sin(alpha - theta1) - cos(theta1) yp - sin(theta1) (zp - d_a),
+/// Tool tip in the table frame with theta1 = alpha, theta2 = phi1 = phi2 = 0 (the equations'
+/// angles): eq. (26), AIM 2007, X_u = xp, Y_u = V1, Z_u = sin(theta1) yp + V2 with
+/// V1 = Delta sin(alpha - theta1) - cos(theta1) yp - sin(theta1) (zp - d_a) + y_t,
 /// V2 = d_t - cos(theta1) zp + d_a cos(theta1) - Delta cos(alpha - theta1).
 pub fn manufacturing_tip(
     t: &TableGeometry,
@@ -41,7 +41,7 @@ pub fn manufacturing_tip(
 ) -> Vector3<f64> {
     let theta1 = alpha;
     let (s, c) = theta1.sin_cos();
-    let v1 = delta * (alpha - theta1).sin() - c * p.y - s * (p.z - t.d_a);
+    let v1 = delta * (alpha - theta1).sin() - c * p.y - s * (p.z - t.d_a) + t.y_t;
     let v2 = t.d_t - c * p.z + t.d_a * c - delta * (alpha - theta1).cos();
     Vector3::new(p.x, v1, s * p.y + v2)
 }
@@ -89,12 +89,14 @@ impl PlatformOfAlpha {
             // eq. (26) with theta1 = alpha: (Y, Z') = -R(alpha) (yp, zp - d_a) with
             // Z' = Z - d_t + Delta and R = [[c, s], [-s, c]], so yp = -c Y + s Z',
             // zp = d_a - s Y - c Z'.
+            // (Y is Y_u - y_t when the rotary axis is off the tilting axis's plane.)
             Of::Manufacturing => {
                 let zq = q.z - t.d_t + delta;
+                let yq = q.y - t.y_t;
                 PlatformOfAlpha {
                     x: q.x,
-                    a: [0.0, zq, -q.y],
-                    b: [t.d_a, -q.y, -zq],
+                    a: [0.0, zq, -yq],
+                    b: [t.d_a, -yq, -zq],
                 }
             }
         }
@@ -220,9 +222,11 @@ fn branch_fails(
     {
         f.add(Constraint::Stroke);
     }
+    // theta1 = alpha is the equations' angle: the joint's is alpha less the table's zero.
+    let theta1 = b.alpha - m.table.theta_zero[0];
     if of == Of::Manufacturing
-        && (b.alpha < m.limits.theta1_min - LIMIT_SLACK
-            || b.alpha > m.limits.theta1_max + LIMIT_SLACK)
+        && (theta1 < m.limits.theta1_min - LIMIT_SLACK
+            || theta1 > m.limits.theta1_max + LIMIT_SLACK)
     {
         f.add(Constraint::Theta1Range);
     }

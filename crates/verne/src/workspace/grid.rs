@@ -137,6 +137,9 @@ impl GridBox {
 /// (y, z) rectangle mapped by eq. (26) for theta1 sampled over [theta1_min, theta1_max],
 /// widened by the largest distance a corner moves between two samples.
 pub fn default_bounds(m: &Machine, of: Of, tool_length: f64) -> Bounds {
+    // The equations' strokes and tilting range (the file's moved by the joints' zero offsets).
+    let model = m.model();
+    let m = &*model;
     let g = &m.module;
     let lim = &m.limits;
     let tau = lim.rod_tilt_max;

@@ -64,7 +64,7 @@ pub fn load(machine: Option<&Path>) -> Result<Option<GliderSpec>, VerneError> {
         return Ok(p.to_str().and_then(GliderSpec::preset));
     }
     let name = p.display().to_string();
-    let bytes = crate::table::read_input_file(p).map_err(|e| VerneError::io(&name, e))?;
+    let bytes = crate::files::read_input_file(p).map_err(|e| VerneError::io(&name, e))?;
     let text = String::from_utf8_lossy(&bytes);
     if !is_glider_text(&text) {
         return Ok(None);

@@ -12,8 +12,8 @@ use verne::glider::{GliderSpec, Sampling, WorkspaceOptions};
 use super::workspace::{GridSize, analyse, nodes_for};
 use crate::cmd::{EXIT_OK, EXIT_ROWS_FAILED};
 use crate::error::VerneError;
+use crate::files::Sink;
 use crate::plot::sweep::{SweepLabels, SweepPoint, sweep_picture};
-use crate::table::Sink;
 
 /// The numeric keys of a glider file that a sweep can change.
 pub const GLIDER_SWEEP_KEYS: [&str; 5] = ["alpha1_deg", "alpha2_deg", "l1", "l2", "l0"];

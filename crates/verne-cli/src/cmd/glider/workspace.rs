@@ -14,8 +14,8 @@ use verne::glider::{
 use crate::cmd::{EXIT_OK, EXIT_ROWS_FAILED};
 use crate::engine::pipeline::{Cell, Units, write_cell};
 use crate::error::VerneError;
+use crate::files::Sink;
 use crate::plot::glider::workspace_picture;
-use crate::table::Sink;
 
 /// Default grid nodes along the longer side of the workspace window.
 pub const WORKSPACE_DEFAULT_NODES: usize = 801;

@@ -663,6 +663,10 @@ pub fn solve(m: &Machine, p: &Vector3<f64>) -> IkBranches {
 
 /// [`solve`] into an existing list (cleared first), so a caller that keeps one avoids copying it.
 pub fn solve_into(m: &Machine, p: &Vector3<f64>, out: &mut IkBranches) {
+    if m.has_zeros() {
+        solve_into(&m.model(), p, out);
+        return joints_of(m, out);
+    }
     let ([leg1], [certified]) = certified_lanes(m, &[*p]);
     let certified = certified.then_some(leg1);
     let g = &m.module;
@@ -682,6 +686,11 @@ pub fn solve_each<'a>(
     m: &Machine,
     rows: impl IntoIterator<Item = (Vector3<f64>, &'a mut IkBranches)>,
 ) {
+    if m.has_zeros() {
+        let mut rows: Vec<_> = rows.into_iter().collect();
+        each_in_lanes::<true>(&m.model(), rows.iter_mut().map(|(p, o)| (*p, &mut **o)));
+        return rows.into_iter().for_each(|(_, o)| joints_of(m, o));
+    }
     each_in_lanes::<true>(m, rows)
 }
 
@@ -692,6 +701,11 @@ pub fn solve_each_baseline<'a>(
     m: &Machine,
     rows: impl IntoIterator<Item = (Vector3<f64>, &'a mut IkBranches)>,
 ) {
+    if m.has_zeros() {
+        let mut rows: Vec<_> = rows.into_iter().collect();
+        each_in_lanes_baseline::<true>(&m.model(), rows.iter_mut().map(|(p, o)| (*p, &mut **o)));
+        return rows.into_iter().for_each(|(_, o)| joints_of(m, o));
+    }
     each_in_lanes_baseline::<true>(m, rows)
 }
 
@@ -703,6 +717,11 @@ pub fn solve_working_each<'a>(
     m: &Machine,
     rows: impl IntoIterator<Item = (Vector3<f64>, &'a mut IkBranches)>,
 ) {
+    if m.has_zeros() {
+        let mut rows: Vec<_> = rows.into_iter().collect();
+        each_in_lanes::<false>(&m.model(), rows.iter_mut().map(|(p, o)| (*p, &mut **o)));
+        return rows.into_iter().for_each(|(_, o)| joints_of(m, o));
+    }
     each_in_lanes::<false>(m, rows)
 }
 
@@ -713,7 +732,21 @@ pub fn solve_working_each_baseline<'a>(
     m: &Machine,
     rows: impl IntoIterator<Item = (Vector3<f64>, &'a mut IkBranches)>,
 ) {
+    if m.has_zeros() {
+        let mut rows: Vec<_> = rows.into_iter().collect();
+        each_in_lanes_baseline::<false>(&m.model(), rows.iter_mut().map(|(p, o)| (*p, &mut **o)));
+        return rows.into_iter().for_each(|(_, o)| joints_of(m, o));
+    }
     each_in_lanes_baseline::<false>(m, rows)
+}
+
+/// The branches of a point solved on [`Machine::model`] with the sliders as `m`'s joints read
+/// them (the equations' rho less the zero offsets): the one place the inverse kinematics
+/// leaves the equations' variables.
+fn joints_of(m: &Machine, out: &mut IkBranches) {
+    for b in out.iter_mut() {
+        b.rho = m.joint_sliders(&b.rho);
+    }
 }
 
 /// [`solve_each`] (`EVERY`) or [`solve_working_each`], built with AVX2 when the processor has it.
@@ -953,6 +986,12 @@ pub(crate) const FAST_MARGIN_RAD: f64 = 1e-6;
 /// lower roots of (12)-(13). Every step is the one [`solve`] takes for that branch; the margins
 /// send every near-tie of a sign, a square root, alpha = 0 or two candidates to [`solve`].
 pub fn working_fast(m: &Machine, p: &Vector3<f64>) -> Option<IkBranch> {
+    if m.has_zeros() {
+        return working_fast(&m.model(), p).map(|b| IkBranch {
+            rho: m.joint_sliders(&b.rho),
+            ..b
+        });
+    }
     match working_lanes(m, &[*p]) {
         [Some(branch)] => Some(branch),
         _ => working_by_cubic(m, p),
@@ -1115,6 +1154,14 @@ pub fn working_lanes<const N: usize>(
     m: &Machine,
     pts: &[Vector3<f64>; N],
 ) -> [Option<IkBranch>; N] {
+    if m.has_zeros() {
+        return working_lanes(&m.model(), pts).map(|b| {
+            b.map(|b| IkBranch {
+                rho: m.joint_sliders(&b.rho),
+                ..b
+            })
+        });
+    }
     let ct = cos_tilt_max(m);
     let (legs, mut sure) = certified_lanes(m, pts);
     let mut out = [None; N];
@@ -1207,6 +1254,10 @@ fn estimated_start(g: &ModuleGeometry, p: &Vector3<f64>) -> (Leg1, bool) {
 /// What `verne ik` needs for one point: the working branch alone when [`working_fast`] is sure
 /// of it, every branch otherwise; [`working`] of the result is the working branch either way.
 pub fn solve_working_into(m: &Machine, p: &Vector3<f64>, out: &mut IkBranches) {
+    if m.has_zeros() {
+        solve_working_into(&m.model(), p, out);
+        return joints_of(m, out);
+    }
     working_or_all_into(m, p, working_fast(m, p), out);
 }
 

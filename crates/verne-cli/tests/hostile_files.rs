@@ -1,5 +1,6 @@
-//! The second round of hostile inputs (issue "reliability, second round"): each finding is
-//! reproduced here with the command that showed it, and the behaviour it must have now.
+//! Hostile inputs to files and streams: closed pipes, non-finite times, line ends, huge grids,
+//! outputs that are inputs, duplicated ids, endless input, huge machine files and rows, odd
+//! machine files. Each case with the command that shows it and the behaviour it must have.
 
 mod common;
 
@@ -15,12 +16,12 @@ fn stderr(o: &std::process::Output) -> String {
 }
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("verne-round2-{}", std::process::id()));
+    let dir = std::env::temp_dir().join(format!("verne-hostile-files-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     dir.join(name)
 }
 
-/// Finding 1, a closed stderr (`verne ik data/example.cl 2>&1 | head -1`): the summary and the
+/// A closed stderr (`verne ik data/example.cl 2>&1 | head -1`): the summary and the
 /// failing rows are dropped, the run exits with its own code (1: the file read in inches has
 /// unreachable rows), not a panic (101).
 #[test]
@@ -49,7 +50,7 @@ fn a_closed_stderr_is_not_a_panic() {
     }
 }
 
-/// Finding 2: A joint table whose `t` is `nan`, `inf` or empty on a row is not "clean": the row is an
+/// A joint table whose `t` is `nan`, `inf` or empty on a row is not "clean": the row is an
 /// `input` finding (exit 1).
 #[test]
 fn verify_does_not_pass_a_time_it_cannot_read() {
@@ -102,7 +103,7 @@ fn verify_does_not_pass_a_time_it_cannot_read() {
     }
 }
 
-/// Finding 3: Line numbers are the file's lines whatever its line ends: LF, CRLF or CR.
+/// Line numbers are the file's lines whatever its line ends: LF, CRLF or CR.
 #[test]
 fn line_numbers_count_crlf_and_cr_lines() {
     for text in [
@@ -124,7 +125,7 @@ fn line_numbers_count_crlf_and_cr_lines() {
     assert!(stderr(&o).contains("<stdin>:3: "), "{}", stderr(&o));
 }
 
-/// Finding 6: A grid too large to count is refused (exit 2), not "0 points".
+/// A grid too large to count is refused (exit 2), not "0 points".
 #[test]
 fn a_grid_that_overflows_is_refused() {
     for args in [
@@ -141,7 +142,7 @@ fn a_grid_that_overflows_is_refused() {
     }
 }
 
-/// Finding 7: An output that is an input of the run is refused before anything is written, under any
+/// An output that is an input of the run is refused before anything is written, under any
 /// name; a read-only output is refused; an existing output keeps its mode; an output through a
 /// dangling symlink is created where the link points.
 #[test]
@@ -209,7 +210,7 @@ fn outputs_never_replace_inputs_or_read_only_files() {
     );
 }
 
-/// Finding 8: A duplicated id in the joint table is fatal with both lines, as in the path.
+/// A duplicated id in the joint table is fatal with both lines, as in the path.
 #[test]
 fn a_duplicated_joint_id_is_fatal() {
     let path = scratch("p8.csv");
@@ -245,7 +246,7 @@ fn a_duplicated_joint_id_is_fatal() {
     );
 }
 
-/// Finding 5: endless or huge input is refused at a bound, naming the line and the limit, not
+/// Endless or huge input is refused at a bound, naming the line and the limit, not
 /// read until memory runs out (`(echo xp,yp,zp; cat /dev/zero) | verne ik`, `-m /dev/zero`,
 /// `verify --joints /dev/zero`). Here 17 MiB stand for the endless stream.
 #[test]
@@ -293,7 +294,7 @@ fn huge_lines_and_machine_files_are_refused_at_a_bound() {
     );
 }
 
-/// Finding 4: a machine file of 40,000 keys and a row of 120,000 columns are read in linear
+/// a machine file of 40,000 keys and a row of 120,000 columns are read in linear
 /// time (measured: 36 s -> 0.6 s and 19.6 s -> 0.03 s, docs/reliability.md; no timing is
 /// asserted here). What is checked: every unknown key is reported at its own line, and the
 /// wide row is converted with its columns passed through.
@@ -353,13 +354,13 @@ fn headers_match_ignoring_case() {
 }
 
 #[test]
-fn round2_item9_negative_step_comment_after_section_and_semicolon_machine_files() {
+fn negative_step_comment_after_section_and_semicolon_machine_files() {
     let stderr = |o: &std::process::Output| String::from_utf8_lossy(&o.stderr).into_owned();
     // --step -10: the value is read, then refused for its sign (not "unexpected argument -1").
     let s = common::run(&["workspace", "--step", "-10"], None);
     assert_eq!(s.status.code(), Some(2));
     assert!(stderr(&s).contains("positive"), "{}", stderr(&s));
-    let dir = std::env::temp_dir().join(format!("verne-item9-{}", std::process::id()));
+    let dir = std::env::temp_dir().join(format!("verne-machine-files-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     // `[module] # comment` keeps the lines of the keys in that section.
     let base = std::fs::read_to_string(format!("{}/data/verne.toml", common::ROOT)).unwrap();
@@ -397,7 +398,7 @@ fn round2_item9_negative_step_comment_after_section_and_semicolon_machine_files(
 /// temporary files of dead runs are removed, a live run's kept; a machine in metres is refused
 /// for its rod lengths.
 #[test]
-fn round2_item9_escapes_early_checks_temp_names_and_tiny_machines() {
+fn escapes_early_checks_temp_names_and_tiny_machines() {
     // ESC and NUL from the input are shown escaped, never raw.
     let out = run(&["ik"], Some("xp,yp,zp\n1,2,\x1b[31mX\x00\n"));
     assert_eq!(out.status.code(), Some(2));
@@ -438,7 +439,7 @@ fn round2_item9_escapes_early_checks_temp_names_and_tiny_machines() {
     assert!(out.stdout.is_empty(), "nothing computed");
 
     // A 250-byte output name: the temporary name would pass NAME_MAX, a shorter one is used.
-    let dir = scratch("item9-rest");
+    let dir = scratch("escapes");
     std::fs::create_dir_all(&dir).unwrap();
     let long = dir.join(format!("{}.csv", "n".repeat(246)));
     let out = run(
