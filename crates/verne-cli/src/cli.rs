@@ -222,8 +222,9 @@ pub struct ModesArgs {
     /// CSV for a script instead of an aligned table.
     #[arg(long)]
     pub csv: bool,
-    /// Also draw every branch (sliders, rods, platform; front view) to FILE.svg or FILE.png.
-    #[arg(long, value_name = "FILE.svg|png")]
+    /// Also draw every branch (sliders, rods, platform; front view) to FILE.svg or FILE.png,
+    /// or in 3D, one view per branch, to FILE.html.
+    #[arg(long, value_name = "FILE.svg|png|html")]
     pub plot: Option<PathBuf>,
     #[command(flatten)]
     pub common: CommonArgs,
@@ -476,6 +477,18 @@ pub struct VerifyArgs {
     /// Report CSV, one row per violation: row,check,value,limit,detail (written atomically).
     #[arg(long, value_name = "REPORT.csv")]
     pub report: Option<PathBuf>,
+    /// A self-contained HTML report: the verdict, the findings at their lines, plots along the
+    /// program and the machine in 3D at any row (no network request; written atomically).
+    #[arg(long, value_name = "REPORT.html")]
+    pub html: Option<PathBuf>,
+    /// JUnit XML for CI test reports: one test suite, one test case per check (written
+    /// atomically).
+    #[arg(long, value_name = "FILE.xml")]
+    pub junit: Option<PathBuf>,
+    /// SARIF 2.1.0 for code scanning: one result per finding at its line, the most severe
+    /// first, at most 5000 (written atomically).
+    #[arg(long, value_name = "FILE.sarif")]
+    pub sarif: Option<PathBuf>,
     /// Summary format.
     #[arg(long, value_enum, default_value = "text")]
     pub format: VerifyFormat,

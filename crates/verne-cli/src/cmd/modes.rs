@@ -6,6 +6,7 @@ use crate::engine::machine_rows::machine_fk_parts;
 use crate::engine::pipeline::{Cell, Units, write_cell};
 use crate::error::VerneError;
 use crate::plot::{BranchSketch, branches_picture};
+use crate::report::html::modes::Branch3d;
 use nalgebra::Vector3;
 use verne::certificate::Certificate;
 use verne::machine::fk::machine_fk;
@@ -29,6 +30,8 @@ struct Listing {
     header: Vec<&'static str>,
     rows: Vec<Vec<Cell>>,
     sketches: Vec<BranchSketch>,
+    /// For the 5-axis queries: each branch's table angles and tool tip (the 3D view's table).
+    tables: Vec<Option<(f64, f64, Vector3<f64>)>>,
 }
 
 /// The columns every listing ends with: the verdict and the kinetostatic figures.
@@ -43,8 +46,11 @@ const FIGURES: [&str; 7] = [
 ];
 
 pub fn run(args: &ModesArgs) -> Result<u8, VerneError> {
-    if let Some(p) = &args.plot {
+    if let Some(p) = args.plot.as_deref().filter(|p| !is_html(p)) {
         crate::plot::check_picture_path(p)?;
+    } else if let Some(p) = &args.plot {
+        crate::files::check_output_path(p)
+            .map_err(|e| VerneError::io(&p.display().to_string(), e))?;
     }
     let machine = match load_mechanism(args.common.machine.as_deref())? {
         Mechanism::Glider(spec) => {
@@ -56,6 +62,12 @@ pub fn run(args: &ModesArgs) -> Result<u8, VerneError> {
                     ("--tool-length", args.tool_length.is_some()),
                 ],
             )?;
+            if args.plot.as_deref().is_some_and(is_html) {
+                return Err(VerneError::Usage(format!(
+                    "--plot FILE.html draws the VERNE machine in 3D; {} is a glider: draw its branches to FILE.svg or FILE.png",
+                    spec.name
+                )));
+            }
             return super::glider::modes(args, spec);
         }
         Mechanism::Verne(m) => m,
@@ -84,7 +96,29 @@ pub fn run(args: &ModesArgs) -> Result<u8, VerneError> {
         &text_rows,
         args.csv,
     ))?;
-    if let Some(path) = &args.plot {
+    if let Some(path) = args.plot.as_deref().filter(|p| is_html(p)) {
+        let branches: Vec<Branch3d> = listing
+            .sketches
+            .iter()
+            .enumerate()
+            .map(|(k, b)| Branch3d {
+                label: b.label.clone(),
+                detail: b.detail.clone(),
+                working: b.working,
+                pose: b.pose,
+                rho: b.rho,
+                table: listing.tables.get(k).copied().flatten(),
+            })
+            .collect();
+        let page = crate::report::html::modes::page(
+            &machine,
+            tool_length(args, &machine),
+            &listing.title,
+            &branches,
+        );
+        crate::files::write_output(path, page.as_bytes())
+            .map_err(|e| VerneError::io(&path.display().to_string(), e))?;
+    } else if let Some(path) = &args.plot {
         branches_picture(path, &machine, &listing.title, &listing.sketches)
             .map_err(|e| VerneError::io(&path.display().to_string(), std::io::Error::other(e)))?;
     }
@@ -93,6 +127,13 @@ pub fn run(args: &ModesArgs) -> Result<u8, VerneError> {
     } else {
         EXIT_OK
     })
+}
+
+/// A `--plot` file that is an HTML page (the 3D views) rather than a picture.
+fn is_html(p: &std::path::Path) -> bool {
+    p.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("html") || e.eq_ignore_ascii_case("htm"))
 }
 
 fn tool_length(args: &ModesArgs, machine: &Machine) -> f64 {
@@ -203,6 +244,7 @@ fn module_listing(machine: &Machine, args: &ModesArgs) -> Result<Listing, VerneE
         header,
         rows: Vec::new(),
         sketches: Vec::new(),
+        tables: Vec::new(),
     };
     let mut add = |pose: ModulePose, rho: Sliders, config: Config, verdict: Verdict| {
         let k = listing.rows.len() + 1;
@@ -297,7 +339,9 @@ fn machine_ik_listing(
     header.extend(FIGURES);
     let mut rows = Vec::new();
     let mut sketches = Vec::new();
+    let mut tables = Vec::new();
     for (k, (b, orientation, theta2)) in candidates.iter().enumerate() {
+        tables.push(Some((b.theta1, theta2, tip)));
         let pose = ModulePose {
             p: b.platform,
             alpha: b.alpha,
@@ -348,6 +392,7 @@ fn machine_ik_listing(
         header,
         rows,
         sketches,
+        tables,
     })
 }
 
@@ -373,7 +418,9 @@ fn machine_fk_listing(machine: &Machine, j: &[f64; 5], tool_length: f64, u: Unit
     header.extend(FIGURES);
     let mut rows = Vec::new();
     let mut sketches = Vec::new();
+    let mut tables = Vec::new();
     for (k, m) in modes.iter().enumerate() {
+        tables.push(Some((theta1, theta2, m.tool.tip)));
         let mut row = vec![Cell::Int(k as i64 + 1)];
         row.extend(machine_fk_parts(m).0);
         row.extend(module_cells(&m.module, None, m.config));
@@ -402,6 +449,7 @@ fn machine_fk_listing(machine: &Machine, j: &[f64; 5], tool_length: f64, u: Unit
         header,
         rows,
         sketches,
+        tables,
     }
 }
 

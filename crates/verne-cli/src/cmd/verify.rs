@@ -7,11 +7,15 @@ use crate::error::VerneError;
 use crate::files::Sink;
 use crate::input::recording::{DEFAULT_COLUMNS, RecordingReader, parse_columns};
 use crate::input::verify_files::{JointInput, PathReader};
+use crate::report::html::verify::{Inputs, VerifyHtml};
+use crate::report::junit::JunitReport;
+use crate::report::sarif::SarifReport;
 use crate::report::verify::{short_number, summary_json, summary_text};
 use crate::toolpath::ReaderReport;
 use csv::ByteRecord;
-use verne::verify::contour::{ContourPath, verify_recording};
-use verne::verify::{RowSource, Thresholds, VerifyOptions, verify};
+use std::sync::Mutex;
+use verne::verify::contour::{ContourPath, verify_recording_observed};
+use verne::verify::{RowObservation, RowSource, Thresholds, VerifyOptions, verify_observed};
 
 use super::{EXIT_OK, EXIT_ROWS_FAILED, load_machine, write_stdout};
 use crate::cli::{VerifyArgs, VerifyFormat};
@@ -39,12 +43,27 @@ fn checked(args: &VerifyArgs) -> Result<u8, VerneError> {
     if args.format == VerifyFormat::Json {
         outputs.push(("--format json", stdout));
     }
+    for (option, p) in [
+        ("--html", &args.html),
+        ("--junit", &args.junit),
+        ("--sarif", &args.sarif),
+    ] {
+        if let Some(p) = p {
+            outputs.push((option, p));
+        }
+    }
     crate::files::check_distinct_outputs(&outputs)?;
     let summary_to_stdout = args.summary.as_ref().is_some_and(|p| p.as_os_str() == "-");
     if summary_to_stdout && args.format == VerifyFormat::Json {
         return Err(VerneError::Usage(
             "--summary - and --format json both write stdout: give --summary a file".into(),
         ));
+    }
+    // The reports' files are checked before the run, written after it.
+    let reports = [&args.html, &args.junit, &args.sarif];
+    for p in reports.into_iter().flatten() {
+        crate::files::check_output_path(p)
+            .map_err(|e| VerneError::io(&p.display().to_string(), e))?;
     }
     let machine = load_machine(args.machine.as_deref())?;
     let machine_name = args
@@ -98,8 +117,30 @@ fn checked(args: &VerifyArgs) -> Result<u8, VerneError> {
         }
         None => None,
     };
+    let started = std::time::Instant::now();
+    let html = args.html.as_ref().map(|_| Mutex::new(VerifyHtml::new()));
+    let mut junit = args.junit.as_ref().map(|_| JunitReport::new());
+    let mut sarif = args.sarif.as_ref().map(|_| SarifReport::new());
     let mut rec = ByteRecord::new();
+    let mut observe = |o: &RowObservation| {
+        if let Some(h) = &html {
+            h.lock().expect("one writer").observe(o);
+        }
+    };
+    let observer: Option<verne::verify::Observer<'_>> = match &html {
+        Some(_) => Some(&mut observe),
+        None => None,
+    };
     let mut write = |v: &verne::verify::Violation| -> Result<(), VerneError> {
+        if let Some(h) = &html {
+            h.lock().expect("one writer").finding(v);
+        }
+        if let Some(j) = junit.as_mut() {
+            j.finding(v);
+        }
+        if let Some(s) = sarif.as_mut() {
+            s.finding(v);
+        }
         if let Some(s) = sink.as_mut() {
             rec.clear();
             rec.push_field(v.row.as_bytes());
@@ -115,10 +156,10 @@ fn checked(args: &VerifyArgs) -> Result<u8, VerneError> {
         Ok(())
     };
     let summary = match (&mut joints, recording.take()) {
-        (Some(j), _) => verify(&machine, &opt, j, &mut path, &mut write),
+        (Some(j), _) => verify_observed(&machine, &opt, j, &mut path, &mut write, observer),
         (None, Some((mut r, contour))) => {
             let name = args.path.display().to_string();
-            verify_recording(&machine, &opt, &mut r, contour, &name, &mut write)
+            verify_recording_observed(&machine, &opt, &mut r, contour, &name, &mut write, observer)
         }
         (None, None) => unreachable!("one joint input is open"),
     };
@@ -159,6 +200,26 @@ fn checked(args: &VerifyArgs) -> Result<u8, VerneError> {
             s.finish()?;
         }
     }
+    let inputs = Inputs {
+        joints: &args.joints,
+        path: &args.path,
+        recording: args.recording,
+        machine: &machine_name,
+    };
+    let seconds = started.elapsed().as_secs_f64();
+    if let (Some(p), Some(h)) = (&args.html, html) {
+        let page = h
+            .into_inner()
+            .expect("one writer")
+            .render(&machine, &opt, &summary, &inputs, p);
+        write_report(p, page.as_bytes())?;
+    }
+    if let (Some(p), Some(j)) = (&args.junit, junit) {
+        write_report(p, j.render(&summary, &inputs, seconds).as_bytes())?;
+    }
+    if let (Some(p), Some(s)) = (&args.sarif, sarif) {
+        write_report(p, s.render(&summary, &inputs).as_bytes())?;
+    }
     if args.format == VerifyFormat::Json {
         write_stdout(&format!("{}\n", summary_json(&summary)))?;
     }
@@ -167,6 +228,12 @@ fn checked(args: &VerifyArgs) -> Result<u8, VerneError> {
     } else {
         EXIT_ROWS_FAILED
     })
+}
+
+/// Writes a report file atomically (a temporary file renamed into place).
+fn write_report(path: &Path, bytes: &[u8]) -> Result<(), VerneError> {
+    crate::files::write_output(path, bytes)
+        .map_err(|e| VerneError::io(&path.display().to_string(), e))
 }
 
 /// The whole intended path, for the nearest-point pairing of a recording: a path row that

@@ -22,8 +22,8 @@ use nalgebra::{SVector, Vector3};
 
 use super::row::mode_of_kind;
 use super::{
-    Check, Item, JointSource, Joints, PairingError, PathPoint, RowSource, Summary, Th,
-    VerifyOptions, Violation, verify,
+    Check, Item, JointSource, Joints, Observer, PairingError, PathPoint, RowSource, Summary, Th,
+    VerifyOptions, Violation, verify_observed,
 };
 use crate::machine::orientation::{move_angles, tool_axis};
 use crate::machine::{MachineFkModes, machine_fk};
@@ -389,7 +389,7 @@ impl<E> RowSource for Projected<'_, E> {
     }
 }
 
-/// [`verify`] of a recording: each joint row against the nearest point of `path` (module
+/// [`verify`](super::verify) of a recording: each joint row against the nearest point of `path` (module
 /// documentation). An empty path is an error of the caller (nothing to compare with).
 pub fn verify_recording<J, E>(
     m: &Machine,
@@ -398,6 +398,23 @@ pub fn verify_recording<J, E>(
     path: ContourPath,
     path_name: &str,
     report: &mut (dyn FnMut(&Violation) -> Result<(), E> + Send),
+) -> Result<Summary, E>
+where
+    J: JointSource<Error = E> + Send,
+    E: From<PairingError> + Send,
+{
+    verify_recording_observed(m, opt, joints, path, path_name, report, None)
+}
+
+/// [`verify_recording`] with an observer of each row, as [`verify_observed`].
+pub fn verify_recording_observed<J, E>(
+    m: &Machine,
+    opt: &VerifyOptions,
+    joints: &mut J,
+    path: ContourPath,
+    path_name: &str,
+    report: &mut (dyn FnMut(&Violation) -> Result<(), E> + Send),
+    observe: Option<Observer<'_>>,
 ) -> Result<Summary, E>
 where
     J: JointSource<Error = E> + Send,
@@ -421,7 +438,7 @@ where
         reach: None,
         _error: std::marker::PhantomData,
     };
-    let mut summary = verify(m, opt, &mut tee, &mut projected, report)?;
+    let mut summary = verify_observed(m, opt, &mut tee, &mut projected, report, observe)?;
     // The recording must cover the path, from its first point to its last: its first sample at
     // the path's start, some sample at its end, and its last sample there.
     let nodes = &projected.path.nodes;

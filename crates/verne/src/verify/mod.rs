@@ -21,6 +21,7 @@
 
 pub mod contour;
 mod findings;
+mod observe;
 mod row;
 mod segment;
 mod thresholds;
@@ -46,6 +47,7 @@ use crate::spec::Machine;
 use crate::tolerance::ACCEPT_RESIDUAL_MM;
 
 pub use findings::{Check, CheckStats, Summary, Violation};
+pub use observe::{PoseObservation, RowObservation, SegmentObservation};
 pub use thresholds::{
     THRESHOLDS, Th, ThresholdSpec, Thresholds, check_threshold_value, threshold_index,
 };
@@ -335,6 +337,9 @@ struct VerifyBatch {
     /// Each joint row with its intended pose, and whether a pairing gap comes before it.
     pairs: Vec<(Paired, bool)>,
     findings: Vec<Violation>,
+    /// With an observer: each row's observation, and the number of the batch's findings up to
+    /// the end of that row's.
+    observed: Vec<(RowObservation, usize)>,
 }
 
 impl VerifyBatch {
@@ -342,6 +347,7 @@ impl VerifyBatch {
         VerifyBatch {
             pairs: Vec::with_capacity(BATCH_ROWS),
             findings: Vec::new(),
+            observed: Vec::new(),
         }
     }
 }
@@ -389,6 +395,10 @@ struct RowEval {
     /// The joint row's line, and its intended row's.
     joints_line: u64,
     path_line: Option<u64>,
+    /// The joint row's 1-based data row.
+    index: u64,
+    /// `module` is the assembly mode the row was checked in (the row has one).
+    has_mode: bool,
 }
 
 /// Per-segment result of the parallel solve, before the order-dependent checks.
@@ -528,6 +538,29 @@ where
     P: RowSource<Row = PathPoint, Error = E> + Send,
     E: From<PairingError> + Send,
 {
+    verify_observed(m, opt, joints, path, report, None)
+}
+
+/// An observer of [`verify_observed`]: receives what was measured at each row.
+pub type Observer<'a> = &'a mut (dyn FnMut(&RowObservation) + Send);
+
+/// [`verify`], and `observe` receives each row's [`RowObservation`] in row order, before that
+/// row's findings reach `report` (the findings after the last row's observation are those of
+/// the path's end: the last stop, the path rows without a joint row).
+pub fn verify_observed<J, P, E>(
+    m: &Machine,
+    opt: &VerifyOptions,
+    joints: &mut J,
+    path: &mut P,
+    report: &mut (dyn FnMut(&Violation) -> Result<(), E> + Send),
+    mut observe: Option<Observer<'_>>,
+) -> Result<Summary, E>
+where
+    J: JointSource<Error = E> + Send,
+    P: RowSource<Row = PathPoint, Error = E> + Send,
+    E: From<PairingError> + Send,
+{
+    let observing = observe.is_some();
     let mut summary = Summary::new();
     summary.timed = joints.timed();
     let at_rest = joints.starts_at_rest();
@@ -568,9 +601,13 @@ where
         |batch: &mut VerifyBatch| {
             let summary = &mut *summary_ref;
             batch.findings.clear();
+            batch.observed.clear();
+            let observed = &mut batch.observed;
+            let found = std::cell::Cell::new(0);
             let mut emit = |v: &Violation, summary: &mut Summary| -> Result<(), E> {
                 summary.add(v);
                 batch.findings.push(v.clone());
+                found.set(found.get() + 1);
                 Ok(())
             };
             let rows: Vec<RowEval> = batch
@@ -598,6 +635,16 @@ where
                     }
                 })
                 .collect();
+            // For an observer, the rows' tool poses and kinetostatics (as the row checks have
+            // them), in parallel too.
+            let poses: Vec<Option<PoseObservation>> = if observing {
+                rows.par_iter()
+                    .with_min_len(16)
+                    .map(|r| pose_observation(m, opt, r))
+                    .collect()
+            } else {
+                Vec::new()
+            };
             // In order: accelerations, flip reversals, output.
             for (k, (row, seg)) in rows.iter().zip(segs).enumerate() {
                 summary.rows += 1;
@@ -618,8 +665,12 @@ where
                     if let Some(p) = prev_seg.take().filter(|_| at_rest) {
                         stop_at_rest(&p, opt, summary, &mut emit)?;
                     }
+                    if observing {
+                        observed.push((observation(row, poses[k], None), found.get()));
+                    }
                     continue;
                 };
+                let mut acceleration = None;
                 summary.segments += 1;
                 if seg.dt > 0.0 {
                     // Timed by the joint table, or by the path's feeds.
@@ -647,6 +698,7 @@ where
                         if !(seg.accelerations_checked && p.accelerations_checked) => {}
                     (Some(_), Some((p, _))) => {
                         let acc = vertex_acceleration(&p.dq, p.dt, Some((&seg.dq, seg.dt)));
+                        acceleration = Some(acc);
                         let (o, found) = acceleration_findings(
                             opt,
                             &acc,
@@ -661,6 +713,7 @@ where
                     }
                     (Some(_), None) if at_rest && seg.accelerations_checked => {
                         let acc = vertex_acceleration(&[0.0; 5], 0.0, Some((&seg.dq, seg.dt)));
+                        acceleration = Some(acc);
                         let (o, found) = acceleration_findings(
                             opt,
                             &acc,
@@ -681,6 +734,18 @@ where
                 for v in &seg.violations {
                     emit(&with_lines(v, lines), summary)?;
                 }
+                if observing {
+                    let measured =
+                        |c: Check| seg.obs.iter().find(|o| o.check == c).map(|o| o.value);
+                    let s = SegmentObservation {
+                        dt: (seg.dt > 0.0).then_some(seg.dt),
+                        rates: seg.rates,
+                        acceleration,
+                        chord_error_mm: measured(Check::ChordError),
+                        chord_axis_deg: measured(Check::ChordAxis),
+                    };
+                    observed.push((observation(row, poses[k], Some(s)), found.get()));
+                }
                 prev_seg = Some(PrevSeg {
                     end_row: row.label.clone(),
                     rates: seg.rates,
@@ -696,9 +761,19 @@ where
             }
             Ok(())
         },
-        // Write: the findings, in row order.
+        // Write: the findings, in row order, each row's after its observation.
         |batch: &mut VerifyBatch| {
-            for v in &batch.findings {
+            let mut written = 0;
+            if let Some(observe) = observe.as_mut() {
+                for (o, end) in &batch.observed {
+                    observe(o);
+                    for v in &batch.findings[written..*end] {
+                        report(v)?;
+                    }
+                    written = *end;
+                }
+            }
+            for v in &batch.findings[written..] {
                 report(v)?;
             }
             Ok(())
@@ -752,6 +827,44 @@ where
         report(&v)?;
     }
     Ok(summary)
+}
+
+/// What the checks measured at `row`, and along the segment that ends on it.
+fn observation(
+    row: &RowEval,
+    pose: Option<PoseObservation>,
+    segment: Option<SegmentObservation>,
+) -> RowObservation {
+    RowObservation {
+        label: row.label.clone(),
+        index: row.index,
+        joints_line: row.joints_line,
+        path_line: row.path_line,
+        joints: row.q,
+        intended: row.point,
+        pose,
+        segment,
+    }
+}
+
+/// The tool pose and kinetostatics of a row in the assembly mode it was checked in, by the same
+/// functions as its checks (eq. (26), `kinetostatics`), and the errors and rod tilt they
+/// measured; `None` for a row without a mode.
+fn pose_observation(m: &Machine, opt: &VerifyOptions, r: &RowEval) -> Option<PoseObservation> {
+    let q = r.q.filter(|_| r.has_mode)?;
+    let measured = |c: Check| r.obs.iter().find(|o| o.check == c).map(|o| o.value);
+    let tool = tool_pose_eq26(&m.table, &r.module, q.theta1, q.theta2, opt.tool_length);
+    let k = kinetostatics(&m.module, &r.module, &q.rho);
+    Some(PoseObservation {
+        module: r.module,
+        tip: tool.tip,
+        axis: crate::machine::orientation::tool_axis(tool.phi1, tool.phi2),
+        tip_error_mm: measured(Check::TipError)?,
+        axis_error_deg: measured(Check::AxisError)?,
+        rod_tilt_deg: measured(Check::Limits)?,
+        amplification: k.amplification,
+        parallel_margin: k.parallel_margin,
+    })
 }
 
 /// The finding of a path row no joint row was paired with, placed at the joint row `at`.

@@ -44,6 +44,8 @@ pub(super) fn eval_row(
         break_before,
         joints_line: p.joints.line,
         path_line: p.point.as_ref().map(|i| i.line),
+        index: p.joints.index,
+        has_mode: false,
     };
     // Path rows the pairing passed over without a joint row of their own.
     for item in &p.missing {
@@ -126,6 +128,7 @@ pub(super) fn eval_row(
         return e;
     };
     e.module = mode.module;
+    e.has_mode = true;
     e.phi1 = mode.tool.phi1;
     let tip_err = (mode.tool.tip - point.tip).norm();
     let cross = mode.axis.cross(&point.axis).norm();
