@@ -4,7 +4,7 @@
 //! `tests/golden/expected/NAME/`. Recorded before the workspace split, so it proves that a
 //! structural change left the behaviour alone.
 //!
-//! `VERNE_GOLDEN_UPDATE=1 cargo test --test golden` rewrites the expected files (then review the
+//! `VERNE_GOLDEN_UPDATE=1 cargo test -p verne-cli --test cli golden::` rewrites the expected files (then review the
 //! diff).
 //!
 //! What is filtered, deliberately, because it depends on the machine's speed or load rather than
@@ -17,7 +17,7 @@ use std::fs;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-mod common;
+use crate::common;
 
 /// The corpus, relative to the repository root ([`common::ROOT`]), where the binary runs so that
 /// the cases' relative paths (`data/...`, `tests/...`) resolve.

@@ -3,7 +3,7 @@
 //! degenerate sets are sampled or where nothing can be tested (the library side is in
 //! crates/verne/tests/hard_sets.rs).
 
-mod common;
+use crate::common;
 
 use verne::parallel_module::fk;
 use verne::spec::Machine;

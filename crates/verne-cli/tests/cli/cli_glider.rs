@@ -1,8 +1,8 @@
 //! CLI tests of the glider mechanisms: run the real binary (`verne ik/fk/modes -m PRESET`,
 //! `verne design`) and compare parsed numbers within named tolerances (docs/gliders.md).
 
+use crate::common;
 use std::collections::HashMap;
-mod common;
 
 use common::run;
 use std::process::Output;

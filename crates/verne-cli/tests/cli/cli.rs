@@ -1,7 +1,7 @@
 //! CLI tests: run the real binary and check the column contract, pass-through, stdin, units,
 //! exit codes and error messages.
 
-mod common;
+use crate::common;
 
 use common::{col, num, run, table_of as table};
 

@@ -4,7 +4,7 @@
 //! XSD (scripts/browser-test.sh also runs xmllint on it), and the HTML report's data against
 //! the CSV report of the same run. (The pages in a browser: scripts/browser-test.sh.)
 
-mod common;
+use crate::common;
 
 use std::collections::{BTreeSet, HashMap};
 use std::path::{Path, PathBuf};

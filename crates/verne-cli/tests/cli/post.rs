@@ -5,7 +5,7 @@
 //! interpolated joints at 64 points of every block, against the intended move computed here
 //! from the CL reader's rows (no code of the post or of verify in between).
 
-mod common;
+use crate::common;
 
 use common::run;
 use nalgebra::Vector3;

@@ -4,7 +4,7 @@
 //! the same findings as the CSV post on the CL corpus), the machine file's `[gcode]` letters,
 //! and the refusals that keep one kind of program from being read as the other.
 
-mod common;
+use crate::common;
 
 use common::{ROOT, col, run, table, table_of};
 

@@ -13,7 +13,7 @@
 //! Filtered as in the golden test, because they measure the machine, not the code: elapsed times
 //! ([`common::filter_timing`]) and a CSV's `seconds` column.
 //!
-//! `VERNE_DOCS_UPDATE=1 cargo test -p verne-cli --test docs` rewrites the examples (and the files)
+//! `VERNE_DOCS_UPDATE=1 cargo test -p verne-cli --test cli docs::` rewrites the examples (and the files)
 //! that no longer match from the actual output, keeping a leading or trailing `...`; review the
 //! diff (times written by an update come from the test build: rerun those commands in release).
 
@@ -21,7 +21,7 @@ use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
-mod common;
+use crate::common;
 
 /// Numbers in the docs are compared to this relative precision (absolute below 1).
 const NUMBER_TOLERANCE: f64 = 1e-9;

@@ -3,7 +3,7 @@
 //! machine's forward kinematics, give back the tool pose), against `verne ik --all` and `verne fk
 //! --all` on the same query, and on a pose built from known joints.
 
-mod common;
+use crate::common;
 
 use common::{col, num, run, table};
 use verne::machine::fk::machine_fk;

@@ -4,7 +4,7 @@
 //! level), a perturbed sample reported at its line by the tip check, lost samples reported, bad
 //! input fatal with the line.
 
-mod common;
+use crate::common;
 
 use std::fs;
 use std::path::{Path, PathBuf};

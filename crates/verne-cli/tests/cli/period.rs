@@ -2,7 +2,7 @@
 //! motion (to within a row per move), its time column steps by the period, and each row's
 //! joints are the inverse kinematics of a pose on the programmed move.
 
-mod common;
+use crate::common;
 
 use common::{col, run, table_of};
 use verne_cl::{Motion, Options};

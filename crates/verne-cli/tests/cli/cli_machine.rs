@@ -1,6 +1,6 @@
 //! CLI tests of the whole machine: tool poses (CSV or APT CL) -> five joints -> tool poses.
 
-mod common;
+use crate::common;
 
 use common::{col, num, run, table};
 

@@ -5,7 +5,7 @@
 //! The synthetic machines come from the library ([`verne::calibrate::synthetic`]: a perturbed
 //! machine file, its own forward kinematics): the truth the command's output is compared with.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 

@@ -2,7 +2,7 @@
 //! outputs that are inputs, duplicated ids, endless input, huge machine files and rows, odd
 //! machine files. Each case with the command that shows it and the behaviour it must have.
 
-mod common;
+use crate::common;
 
 use std::io::Read;
 use std::os::unix::fs::PermissionsExt;

@@ -8,7 +8,7 @@ use verne::machine::{FirstRowChoice, PathState};
 use verne::spec::Machine;
 use verne_cl::{Kind, Options, Row, Summary};
 
-const EXAMPLE: &str = include_str!("../../../data/example.cl");
+const EXAMPLE: &str = include_str!("../../../../data/example.cl");
 
 /// Half a unit of the last printed decimal (4 for coordinates, mm).
 const PRINT_MM: f64 = 0.5e-4;

@@ -10,7 +10,7 @@
 //! - the inverse and the forward of the offset machine give each other back, and verify accepts
 //!   the joints of the offset machine on it and finds them off on the drawing's machine.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 
