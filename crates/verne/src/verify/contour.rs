@@ -42,6 +42,11 @@ pub const SEARCH_WINDOW: usize = 64;
 /// whole path (the window may have lost it: a sample that jumped, the path's start).
 pub const WINDOW_TRUST_MM: f64 = 1.0;
 
+/// Distances to two points of the path closer than this (mm) are a tie: above a recording's
+/// resolution at the tool tip (halsampler's six decimals of mm and degrees: about 2e-5 mm a
+/// metre from the axes), far below any tolerance a check uses.
+const TIE_MM: f64 = 1e-4;
+
 /// Golden-section steps refining the parameter on the nearest segment (0.618^60 ~ 3e-13).
 const GOLDEN_STEPS: usize = 60;
 
@@ -154,11 +159,16 @@ impl ContourPath {
         phi2: f64,
     ) -> Nearest {
         let mut best: Option<(usize, f64, f64, SegmentAngles)> = None;
+        // Points of the path at the same distance (a closed path's start and end, a pass over
+        // the same place): the one nearest the cursor, where the samples before went.
+        let nearer_cursor = |k: usize, b: usize| k.abs_diff(self.cursor) < b.abs_diff(self.cursor);
         for k in range {
             let seg = self.segments[k];
             for sample in both(phi1, phi2) {
                 let (u, d) = self.project(k, &seg, tip, sample);
-                if best.is_none_or(|b| d < b.2) {
+                if best.is_none_or(|b| {
+                    d < b.2 - TIE_MM || (d <= b.2 + TIE_MM && nearer_cursor(k, b.0))
+                }) {
                     best = Some((k, u, d, seg));
                 }
             }
@@ -485,6 +495,33 @@ mod tests {
             Vector3::new(x, y, z),
             tool_axis(phi1_deg.to_radians(), phi2_deg.to_radians()),
         )
+    }
+
+    /// A closed path (it ends where it starts, as a program that returns home): the first
+    /// sample there is the path's start, the last one its end.
+    #[test]
+    fn a_closed_path_starts_at_its_start_and_ends_at_its_end() {
+        let home = point(0.0, 0.0, 100.0, 0.0, 0.0);
+        let mut path = ContourPath::new(vec![
+            home,
+            point(20.0, 10.0, 80.0, 0.0, 0.0),
+            point(40.0, 10.0, 80.0, 10.0, 45.0),
+            point(0.0, 0.0, 100.0, 0.0, 0.0),
+        ]);
+        // The tip rounded as a recording is: a few 1e-7 mm off home.
+        let at_home = Vector3::new(3e-7, -2e-7, 100.0 + 1e-7);
+        let first = path.nearest(&at_home, 0.0, 0.0).unwrap();
+        assert!(first.segment == 0 && first.u < 1e-6, "{first:?}");
+        // Along the way (the way back on the last segment), as a recording's samples follow it.
+        for p in [
+            Vector3::new(10.0, 5.0, 90.0),
+            Vector3::new(30.0, 10.0, 80.0),
+            Vector3::new(20.0, 5.0, 90.0),
+        ] {
+            path.nearest(&p, 0.0, 0.0).unwrap();
+        }
+        let last = path.nearest(&at_home, 0.0, 0.0).unwrap();
+        assert!(last.segment == 2 && last.u > 1.0 - 1e-6, "{last:?}");
     }
 
     #[test]
