@@ -42,9 +42,10 @@ pub const SEARCH_WINDOW: usize = 64;
 /// whole path (the window may have lost it: a sample that jumped, the path's start).
 pub const WINDOW_TRUST_MM: f64 = 1.0;
 
-/// Distances to two points of the path closer than this (mm) are a tie: above a recording's
-/// resolution at the tool tip (halsampler's six decimals of mm and degrees: about 2e-5 mm a
-/// metre from the axes), far below any tolerance a check uses.
+/// Distances to two passes of the path (points more than [`WINDOW_TRUST_MM`] apart along it)
+/// closer than this (mm) are a tie: above a recording's resolution at the tool tip
+/// (halsampler's six decimals of mm and degrees: about 2e-5 mm a metre from the axes), far
+/// below any tolerance a check uses.
 const TIE_MM: f64 = 1e-4;
 
 /// Golden-section steps refining the parameter on the nearest segment (0.618^60 ~ 3e-13).
@@ -76,6 +77,8 @@ pub struct ContourPath {
     segments: Vec<SegmentAngles>,
     /// The segment of the previous sample (the search starts there).
     cursor: usize,
+    /// The length of the path's tips up to each point (mm).
+    along: Vec<f64>,
 }
 
 /// The nearest point of the path to a sample.
@@ -115,10 +118,17 @@ impl ContourPath {
                 }
             })
             .collect();
+        let along = std::iter::once(0.0)
+            .chain(points.windows(2).scan(0.0, |total, w| {
+                *total += (w[1].tip - w[0].tip).norm();
+                Some(*total)
+            }))
+            .collect();
         ContourPath {
             nodes: points,
             segments,
             cursor: 0,
+            along,
         }
     }
 
@@ -159,15 +169,25 @@ impl ContourPath {
         phi2: f64,
     ) -> Nearest {
         let mut best: Option<(usize, f64, f64, SegmentAngles)> = None;
-        // Points of the path at the same distance (a closed path's start and end, a pass over
-        // the same place): the one nearest the cursor, where the samples before went.
+        // Two passes of the path as near the sample (a closed path's start and end, a pass over
+        // the same place again): the one nearest the cursor, where the samples before went.
+        // Otherwise the nearer point, exactly.
+        let at = |k: usize, u: f64| {
+            let k1 = (k + 1).min(self.along.len() - 1);
+            self.along[k] + u * (self.along[k1] - self.along[k])
+        };
         let nearer_cursor = |k: usize, b: usize| k.abs_diff(self.cursor) < b.abs_diff(self.cursor);
         for k in range {
             let seg = self.segments[k];
             for sample in both(phi1, phi2) {
                 let (u, d) = self.project(k, &seg, tip, sample);
                 if best.is_none_or(|b| {
-                    d < b.2 - TIE_MM || (d <= b.2 + TIE_MM && nearer_cursor(k, b.0))
+                    let other_pass = (at(k, u) - at(b.0, b.1)).abs() > WINDOW_TRUST_MM;
+                    if other_pass && (d - b.2).abs() <= TIE_MM {
+                        nearer_cursor(k, b.0)
+                    } else {
+                        d < b.2
+                    }
                 }) {
                     best = Some((k, u, d, seg));
                 }
