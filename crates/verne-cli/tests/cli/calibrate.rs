@@ -366,24 +366,18 @@ fn bad_input_is_refused_with_its_line() {
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("18 readings for 21 unknowns"), "{err}");
     // A NaN and an empty cell: the file, line and column.
-    let mut nan = lines.clone();
-    let replaced = {
-        let mut c: Vec<&str> = nan[5].split(',').collect();
-        c[1] = "NaN";
-        c.join(",")
+    // The measurement file with cell `col` of line `row` (0-based) replaced by `value`.
+    let with_cell = |row: usize, col: usize, value: &str| -> String {
+        let mut out: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
+        let mut c: Vec<&str> = lines[row].split(',').collect();
+        c[col] = value;
+        out[row] = c.join(",");
+        out.join("\n") + "\n"
     };
-    nan[5] = &replaced;
-    let (code, err) = attempt("nan.csv", &(nan.join("\n") + "\n"), &[]);
+    let (code, err) = attempt("nan.csv", &with_cell(5, 1, "NaN"), &[]);
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("nan.csv:6: column rho2"), "{err}");
-    let mut empty = lines.clone();
-    let blank = {
-        let mut c: Vec<&str> = empty[7].split(',').collect();
-        c[5] = "";
-        c.join(",")
-    };
-    empty[7] = &blank;
-    let (code, err) = attempt("empty.csv", &(empty.join("\n") + "\n"), &[]);
+    let (code, err) = attempt("empty.csv", &with_cell(7, 5, ""), &[]);
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("empty.csv:8: column x"), "{err}");
     // A reading 40 mm off: far from any pose, its line; exit 1.

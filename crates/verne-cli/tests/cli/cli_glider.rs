@@ -30,17 +30,7 @@ struct Table {
 
 impl Table {
     fn of(out: &Output) -> Table {
-        let text = String::from_utf8(out.stdout.clone()).unwrap();
-        let mut lines = text.lines();
-        let header = lines
-            .next()
-            .unwrap_or("")
-            .split(',')
-            .map(str::to_string)
-            .collect();
-        let rows = lines
-            .map(|l| l.split(',').map(str::to_string).collect())
-            .collect();
+        let (header, rows) = common::table(&String::from_utf8(out.stdout.clone()).unwrap());
         Table { header, rows }
     }
 
